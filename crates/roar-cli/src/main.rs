@@ -1,0 +1,3 @@
+//! The `roar` command line.
+
+fn main() {}

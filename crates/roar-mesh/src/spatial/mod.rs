@@ -1,0 +1,4 @@
+//! Geometric kernels on plain buffers (`&[DVec3]` positions, `&[[u32; 3]]` triangles), written
+//! once here and used by every crate: triangle BVH, closest point, ray cast, exact
+//! triangle–triangle test, fast winding number, regular face sampling, the `Projector` trait and
+//! the `Normalization` into the camera rig's sphere.
