@@ -1,4 +1,7 @@
 //! # roar-cli
 //!
-//! The library half of the `roar` command: the subcommands' logic, and later the reconstruction
-//! pipeline that composes the other crates.
+//! The library half of the `roar` command: one module per subcommand (argument struct plus a
+//! `run` function), and later the reconstruction pipeline that composes the other crates.
+
+pub mod commands;
+pub mod example;

@@ -1,3 +1,42 @@
-//! The `roar` command line.
+//! The `roar` command line: a thin clap front end over `roar_cli::commands`.
+//!
+//! Every failure is one line on stderr (`roar: error: …`) and a non-zero exit; nothing is written
+//! to an output path unless the whole job succeeded (writers are atomic).
 
-fn main() {}
+use std::process::ExitCode;
+
+use clap::{Parser, Subcommand};
+use roar_cli::commands;
+
+/// Clean, closed, budgeted triangle meshes from messy 3D shapes.
+#[derive(Parser)]
+#[command(name = "roar", version, about)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Vertex and face counts, bounding box, and whether the mesh is a closed 2-manifold
+    /// (its genus and components if so, the first reason it is not otherwise).
+    Info(commands::info::InfoArgs),
+    /// Write the messy chair-like example soup that the README runs on.
+    ExampleSoup(commands::example::ExampleArgs),
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Command::Info(args) => commands::info::run(&args),
+        Command::ExampleSoup(args) => commands::example::run(&args),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(error) => {
+            // `{:#}` joins the context chain into one line.
+            eprintln!("roar: error: {error:#}");
+            ExitCode::FAILURE
+        }
+    }
+}

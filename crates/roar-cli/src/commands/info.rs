@@ -1,0 +1,137 @@
+//! `roar info FILE [--json]`: what is in a mesh file, and whether it is a closed 2-manifold.
+
+use std::path::PathBuf;
+
+use anyhow::Context;
+use clap::Args;
+use glam::DVec3;
+use roar_mesh::Mesh;
+use serde::Serialize;
+
+/// Arguments of `roar info`.
+#[derive(Args, Debug)]
+pub struct InfoArgs {
+    /// Mesh file (OBJ, PLY, STL or OFF; extension case-insensitive).
+    pub file: PathBuf,
+    /// Print JSON instead of text.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// What `roar info` reports.
+#[derive(Debug, Serialize)]
+pub struct Info {
+    /// Vertices as stored in the file.
+    pub vertices: usize,
+    /// Triangles after fan triangulation of polygons.
+    pub faces: usize,
+    /// Distinct vertex positions (bit-identical positions welded).
+    pub vertices_welded: usize,
+    /// Axis-aligned bounding box of the referenced vertices, `[min, max]`.
+    pub bbox: [[f64; 3]; 2],
+    /// Whether the welded mesh is a closed, oriented 2-manifold.
+    pub closed_manifold: bool,
+    /// Genus (summed over components), if a closed manifold.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub genus: Option<i64>,
+    /// Connected components, if a closed manifold.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub components: Option<usize>,
+    /// The first reason the welded mesh is not a closed manifold.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub not_manifold_because: Option<String>,
+}
+
+/// Runs `roar info`.
+pub fn run(args: &InfoArgs) -> anyhow::Result<()> {
+    let info = info(&args.file)?;
+    if args.json {
+        println!("{}", serde_json::to_string_pretty(&info)?);
+    } else {
+        print!("{}", format_text(&args.file, &info));
+    }
+    Ok(())
+}
+
+/// Reads `path` and gathers its [`Info`].
+pub fn info(path: &std::path::Path) -> anyhow::Result<Info> {
+    let soup = roar_io::read_mesh(path)?;
+    let (welded, _) = soup.welded();
+    let (positions, triangles) = drop_unreferenced(&welded.positions, &welded.triangles);
+    let bbox = bounding_box(&positions)
+        .with_context(|| format!("{}: no referenced vertices", path.display()))?;
+    let mut info = Info {
+        vertices: soup.positions.len(),
+        faces: soup.triangles.len(),
+        vertices_welded: welded.positions.len(),
+        bbox,
+        closed_manifold: false,
+        genus: None,
+        components: None,
+        not_manifold_because: None,
+    };
+    match Mesh::from_triangles(positions, &triangles) {
+        Ok(mesh) => {
+            info.closed_manifold = true;
+            info.components = Some(mesh.components().0);
+            info.genus = Some(mesh.genus());
+        }
+        Err(reason) => info.not_manifold_because = Some(reason.to_string()),
+    }
+    Ok(info)
+}
+
+fn format_text(path: &std::path::Path, info: &Info) -> String {
+    let [lo, hi] = info.bbox;
+    let mut text = format!(
+        "{}\n  vertices  {} ({} distinct positions)\n  faces     {}\n  bbox      [{}, {}, {}] .. [{}, {}, {}]\n",
+        path.display(),
+        info.vertices,
+        info.vertices_welded,
+        info.faces,
+        lo[0],
+        lo[1],
+        lo[2],
+        hi[0],
+        hi[1],
+        hi[2],
+    );
+    match (&info.not_manifold_because, info.genus, info.components) {
+        (None, Some(genus), Some(components)) => text.push_str(&format!(
+            "  closed 2-manifold: yes, genus {genus}, {components} component(s)\n"
+        )),
+        (Some(reason), _, _) => {
+            text.push_str(&format!("  closed 2-manifold: no ({reason})\n"));
+        }
+        _ => {}
+    }
+    text
+}
+
+/// Keeps only the vertices some triangle references, renumbering the triangles.
+fn drop_unreferenced(positions: &[DVec3], triangles: &[[u32; 3]]) -> (Vec<DVec3>, Vec<[u32; 3]>) {
+    let mut new_index = vec![u32::MAX; positions.len()];
+    let mut kept = Vec::new();
+    let triangles = triangles
+        .iter()
+        .map(|t| {
+            t.map(|v| {
+                let slot = &mut new_index[v as usize];
+                if *slot == u32::MAX {
+                    *slot = kept.len() as u32;
+                    kept.push(positions[v as usize]);
+                }
+                *slot
+            })
+        })
+        .collect();
+    (kept, triangles)
+}
+
+fn bounding_box(positions: &[DVec3]) -> Option<[[f64; 3]; 2]> {
+    let first = *positions.first()?;
+    let (lo, hi) = positions
+        .iter()
+        .fold((first, first), |(lo, hi), p| (lo.min(*p), hi.max(*p)));
+    Some([lo.to_array(), hi.to_array()])
+}
