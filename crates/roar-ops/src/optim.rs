@@ -22,6 +22,23 @@
 //!
 //! δ_v and ℓ_v are computed from the positions *before* the step, for all vertices at once, so
 //! the result does not depend on the vertex order or on the thread count.
+//!
+//! ```
+//! use glam::DVec3;
+//! use roar_ops::optim::{Optimizer, OptimizerOptions};
+//!
+//! // A tetrahedron pulled toward the origin by L = Σ‖v‖².
+//! let mut positions = vec![DVec3::X, DVec3::Y, DVec3::Z, DVec3::ONE];
+//! let triangles = [[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]];
+//! let mut opt = Optimizer::new(positions.len(), OptimizerOptions::default())?;
+//! for _ in 0..10 {
+//!     let gradient: Vec<DVec3> = positions.iter().map(|p| 2.0 * *p).collect();
+//!     let stats = opt.step(&mut positions, &triangles, &gradient)?;
+//!     assert!(stats.max_move <= 0.05 * 0.15);
+//! }
+//! assert_eq!(opt.step_count(), 10);
+//! # Ok::<(), roar_ops::optim::OptimError>(())
+//! ```
 
 mod adjacency;
 mod transfer;
@@ -605,4 +622,58 @@ fn update_vertex(
     partial.sum_move += moved;
     partial.max_move = partial.max_move.max(moved);
     partial.sum_nu += s.nu;
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn local_geometry_matches_brute_force() {
+        // A square pyramid (apex 4) with a skewed apex, plus a dead vertex 5.
+        let positions = [
+            DVec3::new(0.0, 0.0, 0.0),
+            DVec3::new(1.0, 0.0, 0.0),
+            DVec3::new(1.0, 1.0, 0.0),
+            DVec3::new(0.0, 1.0, 0.0),
+            DVec3::new(0.3, 0.2, 0.05),
+            DVec3::new(9.0, 9.0, 9.0),
+        ];
+        let triangles = [
+            [0, 1, 4],
+            [1, 2, 4],
+            [2, 3, 4],
+            [3, 0, 4],
+            [0, 2, 1],
+            [0, 3, 2],
+        ];
+        let adjacency = VertexAdjacency::from_triangles(6, &triangles).unwrap();
+        let mut lap = vec![DVec3::NAN; 6];
+        let mut len = vec![f64::NAN; 6];
+        local_geometry(&adjacency, &positions, 0.5, 0, &mut lap, &mut len);
+
+        for v in 0..5 {
+            let mut ring: Vec<usize> = triangles
+                .iter()
+                .filter(|t| t.contains(&(v as u32)))
+                .flat_map(|t| t.iter().map(|&u| u as usize))
+                .filter(|&u| u != v)
+                .collect();
+            ring.sort();
+            ring.dedup();
+            let mean = ring.iter().map(|&u| positions[u]).sum::<DVec3>() / ring.len() as f64;
+            let shortest = ring
+                .iter()
+                .map(|&u| positions[v].distance(positions[u]))
+                .fold(f64::INFINITY, f64::min);
+            assert!(
+                (lap[v] - (positions[v] - mean)).length() < 1e-15,
+                "δ of {v}"
+            );
+            assert_eq!(len[v], shortest.min(0.5), "ℓ of {v}");
+        }
+        // Apex: shortest edge is to vertex 0 (√(0.09 + 0.04 + 0.0025) < 0.5).
+        assert!((len[4] - (0.1325f64).sqrt()).abs() < 1e-15);
+        assert_eq!((lap[5], len[5]), (DVec3::ZERO, 0.0), "dead vertex");
+    }
 }
