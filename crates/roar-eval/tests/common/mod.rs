@@ -1,8 +1,10 @@
-//! Test-only mesh loader (OBJ, OFF, STL, PLY) and shared fixtures. To be replaced by roar-io.
+//! Test-only mesh loader (OBJ, OFF, STL, PLY; to be replaced by roar-io) and procedural shapes.
 #![allow(dead_code)]
 
 use glam::DVec3;
 use std::path::{Path, PathBuf};
+
+pub mod shapes;
 
 /// A loaded soup: positions as stored, polygons fan-triangulated.
 pub struct Soup {
