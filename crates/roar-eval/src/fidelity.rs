@@ -109,18 +109,21 @@ pub fn fidelity(
     ref_triangles: &[[u32; 3]],
     options: &ChamferOptions,
 ) -> Option<FidelityStats> {
-    let ours = sample_surface(positions, triangles, options.samples, options.seed);
-    let theirs = sample_surface(
-        ref_positions,
-        ref_triangles,
-        options.samples,
-        options.seed.wrapping_add(1),
+    // The two sides are independent: sample them, and query them, concurrently.
+    let (ours, theirs) = rayon::join(
+        || sample_surface(positions, triangles, options.samples, options.seed),
+        || {
+            let seed = options.seed.wrapping_add(1);
+            sample_surface(ref_positions, ref_triangles, options.samples, seed)
+        },
     );
     if ours.points.is_empty() || theirs.points.is_empty() {
         return None;
     }
-    let forward = nearest_neighbours(&theirs.points, &ours.points);
-    let backward = nearest_neighbours(&ours.points, &theirs.points);
+    let (forward, backward) = rayon::join(
+        || nearest_neighbours(&theirs.points, &ours.points),
+        || nearest_neighbours(&ours.points, &theirs.points),
+    );
     let f = one_direction(&ours, &theirs, &forward);
     let b = one_direction(&theirs, &ours, &backward);
     let diag = bbox_diagonal(ref_positions, ref_triangles);
