@@ -1,4 +1,54 @@
 //! # roar-eval
 //!
-//! Will own the metrics on arbitrary triangle soups: Chamfer distance, normal consistency,
-//! triangle quality, self-intersections, manifoldness and topology, gathered in a serde `Report`.
+//! Metrics on arbitrary triangle soups (spec §6.1), on plain buffers (`&[DVec3]`, `&[[u32; 3]]`):
+//!
+//! - [`topology`]: boundary edges and loops, non-manifold edges and vertices, inconsistent winding,
+//!   duplicates, degenerate faces, components, watertightness, Euler characteristic, genus, with the
+//!   counting rules of the shared test data's `SOURCES.md`; [`weld_bit_identical`] merges exact
+//!   duplicate positions first.
+//! - [`triangle_quality`]: aspect ratio `Q = R/(2r)` statistics.
+//! - [`fidelity`]: Chamfer L2 (mean and PyTorch3D squared-sum forms), Hausdorff and normal cosine
+//!   similarity against a reference, from area-weighted samples and k-d tree nearest neighbours.
+//! - [`evaluate`] gathers everything in a serde [`Report`].
+
+mod fidelity;
+mod nearest;
+mod quality;
+mod report;
+pub mod sampling;
+mod topology;
+
+pub use fidelity::{ChamferOptions, FidelityStats, bbox_diagonal, fidelity};
+pub use nearest::{Nearest, nearest_neighbours};
+pub use quality::{QualityStats, aspect_ratio, triangle_quality};
+pub use report::{
+    EvalOptions, OrientationStats, Report, SelfIntersectionStats, evaluate, validate_soup,
+};
+pub use topology::{TopologyStats, signed_volume, topology, weld_bit_identical};
+
+/// Why a soup cannot be evaluated.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum EvalError {
+    /// A triangle refers to a vertex that does not exist.
+    #[error(
+        "{mesh}: triangle {face} refers to vertex {index}, but there are only {vertices} vertices"
+    )]
+    IndexOutOfRange {
+        /// Which input: "mesh" or "reference".
+        mesh: &'static str,
+        /// Triangle index.
+        face: usize,
+        /// The offending vertex index.
+        index: u32,
+        /// Number of vertices.
+        vertices: usize,
+    },
+    /// A vertex has a NaN or infinite coordinate.
+    #[error("{mesh}: vertex {vertex} has a non-finite coordinate")]
+    NonFinite {
+        /// Which input: "mesh" or "reference".
+        mesh: &'static str,
+        /// Vertex index.
+        vertex: usize,
+    },
+}

@@ -1,0 +1,145 @@
+//! Chamfer, Hausdorff and normal similarity on analytic shapes; the evaluation report.
+
+mod common;
+
+use common::shapes::{cube, icosphere};
+use glam::DVec3;
+use roar_eval::{ChamferOptions, EvalError, EvalOptions, evaluate, fidelity};
+
+fn options(samples: usize, seed: u64) -> ChamferOptions {
+    ChamferOptions { samples, seed }
+}
+
+#[test]
+fn chamfer_between_concentric_spheres_is_the_radius_gap() {
+    let (p1, t1) = icosphere(1.0, 4);
+    let (p2, t2) = icosphere(1.1, 4);
+    let f = fidelity(&p2, &t2, &p1, &t1, &options(50_000, 3)).unwrap();
+    assert!(
+        (f.chamfer_l2 - 0.1).abs() < 0.003,
+        "chamfer {}",
+        f.chamfer_l2
+    );
+    assert!(
+        (f.chamfer_l2_squared_sum - 0.02).abs() < 0.0012,
+        "{}",
+        f.chamfer_l2_squared_sum
+    );
+    assert!(
+        f.hausdorff >= f.chamfer_l2 && f.hausdorff < 0.13,
+        "{}",
+        f.hausdorff
+    );
+    assert!((f.chamfer_l2_over_diag - f.chamfer_l2 / f.reference_diagonal).abs() < 1e-15);
+    assert!((f.reference_diagonal - 2.0 * 3f64.sqrt()).abs() < 0.4);
+    assert!(f.normal_cosine > 0.99 && f.normal_cosine_abs >= f.normal_cosine);
+}
+
+#[test]
+fn inverted_winding_flips_the_signed_cosine_only() {
+    let (p, t) = icosphere(1.0, 3);
+    let inverted: Vec<[u32; 3]> = t.iter().map(|&[a, b, c]| [a, c, b]).collect();
+    let f = fidelity(&p, &inverted, &p, &t, &options(20_000, 1)).unwrap();
+    assert!(f.normal_cosine < -0.99, "{}", f.normal_cosine);
+    assert!(f.normal_cosine_abs > 0.99);
+}
+
+#[test]
+fn chamfer_of_a_mesh_with_itself_is_sampling_noise() {
+    let (p, t) = icosphere(1.0, 3);
+    let f = fidelity(&p, &t, &p, &t, &options(50_000, 5)).unwrap();
+    // Mean spacing of 50k samples on a unit sphere is about √(4π/50k) ≈ 0.016.
+    assert!(f.chamfer_l2 < 0.01, "self chamfer {}", f.chamfer_l2);
+    assert!(
+        f.chamfer_l2 > 0.0,
+        "different seeds on each side give distinct samples"
+    );
+    let g = fidelity(&p, &t, &p, &t, &options(50_000, 99)).unwrap();
+    assert!(
+        (f.chamfer_l2 - g.chamfer_l2).abs() < 0.1 * f.chamfer_l2,
+        "noise level is stable"
+    );
+    let h = fidelity(&p, &t, &p, &t, &options(50_000, 5)).unwrap();
+    assert_eq!(f, h, "same seed, bit-identical result");
+}
+
+#[test]
+fn nothing_to_sample_gives_no_fidelity() {
+    let (p, t) = cube();
+    let flat = [DVec3::ZERO, DVec3::X, DVec3::X * 2.0];
+    assert!(fidelity(&flat, &[[0, 1, 2]], &p, &t, &options(100, 0)).is_none());
+    assert!(fidelity(&p, &t, &p, &[], &options(100, 0)).is_none());
+}
+
+#[test]
+fn report_serializes_its_sections() {
+    let (p, t) = cube();
+    let opts = EvalOptions {
+        chamfer: options(2_000, 0),
+    };
+    let without = evaluate(&p, &t, None, &opts).unwrap();
+    let json = serde_json::to_value(&without).unwrap();
+    for (section, key) in [
+        ("topology", "vertices"),
+        ("topology", "faces"),
+        ("topology", "boundary_edges"),
+        ("topology_welded", "nonmanifold_edges"),
+        ("topology_welded", "nonmanifold_vertices"),
+        ("topology_welded", "components"),
+        ("topology_welded", "watertight"),
+        ("quality", "aspect_ratio_median"),
+        ("quality", "degenerate"),
+        ("orientation", "signed_volume"),
+    ] {
+        assert!(json[section].get(key).is_some(), "missing {section}.{key}");
+    }
+    assert!(json.get("fidelity").is_none() && json.get("self_intersections").is_none());
+    assert_eq!(json["topology_welded"]["genus"], 0);
+    assert!((json["orientation"]["signed_volume"].as_f64().unwrap() - 1.0).abs() < 1e-12);
+    // Cube faces are right isosceles triangles.
+    let q = json["quality"]["aspect_ratio_median"].as_f64().unwrap();
+    assert!((q - (1.0 + 2f64.sqrt()) / 2.0).abs() < 1e-12);
+
+    let with = evaluate(&p, &t, Some((&p, &t)), &opts).unwrap();
+    let json = serde_json::to_value(&with).unwrap();
+    for key in [
+        "chamfer_l2",
+        "chamfer_l2_over_diag",
+        "chamfer_l2_squared_sum",
+        "normal_cosine",
+        "normal_cosine_abs",
+        "hausdorff",
+        "hausdorff_over_diag",
+    ] {
+        assert!(json["fidelity"][key].is_number(), "missing fidelity.{key}");
+    }
+}
+
+#[test]
+fn invalid_input_is_an_error_not_a_panic() {
+    let (mut p, t) = cube();
+    let opts = EvalOptions::default();
+    let bad = [[0, 1, 99]];
+    assert!(matches!(
+        evaluate(&p, &bad, None, &opts),
+        Err(EvalError::IndexOutOfRange {
+            face: 0,
+            index: 99,
+            ..
+        })
+    ));
+    assert!(matches!(
+        evaluate(&p, &t, Some((&p, &bad)), &opts),
+        Err(EvalError::IndexOutOfRange {
+            mesh: "reference",
+            ..
+        })
+    ));
+    p[3].y = f64::NAN;
+    assert!(matches!(
+        evaluate(&p, &t, None, &opts),
+        Err(EvalError::NonFinite { vertex: 3, .. })
+    ));
+    let empty = evaluate(&[], &[], None, &opts).unwrap();
+    assert!(!empty.topology.watertight && empty.quality.aspect_ratio_median.is_none());
+}
