@@ -85,3 +85,30 @@ impl Mesh {
         self.outgoing(a).find(|&h| self.head(h) == b)
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use crate::shapes;
+
+    #[test]
+    fn circulation_is_counter_clockwise_and_complete() {
+        let m = shapes::perturbed(&shapes::icosphere(2), 0.01, 1);
+        for v in m.vertices() {
+            let ring: Vec<_> = m.neighbors(v).collect();
+            let faces: Vec<_> = m.faces_around(v).collect();
+            assert_eq!(ring.len(), m.valence(v));
+            assert_eq!(faces.len(), ring.len());
+            for i in 0..ring.len() {
+                // Consecutive neighbours x, y span the face (v, x, y), counter-clockwise.
+                let (x, y) = (ring[i], ring[(i + 1) % ring.len()]);
+                let fv = m.face_vertices(faces[i]);
+                let k = fv.iter().position(|&w| w == v).unwrap();
+                assert_eq!([fv[(k + 1) % 3], fv[(k + 2) % 3]], [x, y]);
+            }
+            for &x in &ring {
+                let h = m.find_halfedge(v, x).unwrap();
+                assert_eq!((m.tail(h), m.head(h)), (v, x));
+            }
+        }
+    }
+}

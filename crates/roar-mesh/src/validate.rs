@@ -187,3 +187,90 @@ impl Mesh {
         Ok(())
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::shapes;
+
+    fn mesh() -> Mesh {
+        shapes::icosphere(1)
+    }
+
+    #[test]
+    fn valid_mesh_passes() {
+        mesh().validate().unwrap();
+    }
+
+    #[test]
+    fn detects_broken_next_cycle() {
+        let mut m = mesh();
+        // Point h0's next at a half-edge of another face.
+        let h0 = m.halfedge_of_face(FaceId::from_index(0));
+        let other = m.halfedge_of_face(FaceId::from_index(5));
+        m.he_next[h0.index()] = other.raw();
+        assert!(matches!(
+            m.validate(),
+            Err(ValidationError::FaceMismatch { .. } | ValidationError::NextCycle(_))
+        ));
+    }
+
+    #[test]
+    fn detects_wrong_head() {
+        let mut m = mesh();
+        let h = HalfedgeId::from_index(0);
+        let wrong = m.opposite_vertex(h);
+        m.he_head[h.index()] = wrong.raw();
+        assert!(m.validate().is_err());
+    }
+
+    #[test]
+    fn detects_dead_references() {
+        let mut m = mesh();
+        m.f_alive[3] = false;
+        m.n_live_faces -= 1;
+        assert!(matches!(
+            m.validate(),
+            Err(ValidationError::DeadReference { .. })
+        ));
+        let mut m = mesh();
+        m.v_alive[7] = false;
+        m.n_live_vertices -= 1;
+        assert!(matches!(
+            m.validate(),
+            Err(ValidationError::DeadReference { .. })
+        ));
+    }
+
+    #[test]
+    fn detects_bad_vertex_and_face_pointers() {
+        let mut m = mesh();
+        let v = VertexId::from_index(0);
+        let incoming = m.halfedge_of_vertex(v).twin();
+        m.v_halfedge[0] = incoming.raw();
+        assert!(matches!(
+            m.validate(),
+            Err(ValidationError::VertexHalfedge { .. })
+        ));
+        let mut m = mesh();
+        let h = m.halfedge_of_face(FaceId::from_index(1));
+        m.f_halfedge[0] = h.raw();
+        assert!(matches!(
+            m.validate(),
+            Err(ValidationError::FaceHalfedge { .. })
+        ));
+    }
+
+    #[test]
+    fn detects_counter_drift() {
+        let mut m = mesh();
+        m.n_live_edges += 1;
+        assert!(matches!(m.validate(), Err(ValidationError::Counts(_))));
+        let mut m = mesh();
+        m.positions.pop();
+        assert!(matches!(
+            m.validate(),
+            Err(ValidationError::ArrayLengths(_))
+        ));
+    }
+}

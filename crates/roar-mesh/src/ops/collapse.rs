@@ -101,6 +101,7 @@ impl Mesh {
         for e in removed_edges {
             self.kill_edge(e);
         }
+        self.paranoid_check("collapse");
         Ok(Collapse {
             survivor: w.b,
             removed: w.a,

@@ -54,6 +54,7 @@ impl Mesh {
         self.set_triangle(w.f1, [w.t, w.t2, w.h1], [w.d, w.b, w.c]);
         self.set_vertex_halfedge(w.a, w.t1);
         self.set_vertex_halfedge(w.b, w.h1);
+        self.paranoid_check("flip");
         Ok(e)
     }
 }

@@ -88,4 +88,16 @@ impl Mesh {
             Err(TopoError::DeadElement(Element::Halfedge(h)))
         }
     }
+
+    /// With the `paranoid` feature, validates the whole mesh after an operator and panics with
+    /// the broken invariant (a bug in this crate). Without it, does nothing.
+    #[inline]
+    pub(crate) fn paranoid_check(&self, op: &str) {
+        #[cfg(feature = "paranoid")]
+        if let Err(e) = self.validate() {
+            panic!("roar-mesh invariant broken by {op} (bug): {e}");
+        }
+        #[cfg(not(feature = "paranoid"))]
+        let _ = op;
+    }
 }

@@ -64,6 +64,7 @@ impl Mesh {
 
         self.set_vertex_halfedge(m, mb);
         self.set_vertex_halfedge(w.b, w.h1);
+        self.paranoid_check("split_edge");
         EdgeSplit {
             new_vertex: m,
             parents: [w.a, w.b],

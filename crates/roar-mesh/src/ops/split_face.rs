@@ -62,6 +62,7 @@ impl Mesh {
         self.set_triangle(n2, [h2, e0, e2.twin()], [p0, m, p2]);
 
         self.set_vertex_halfedge(m, e0.twin());
+        self.paranoid_check("split_face");
         FaceSplit {
             new_vertex: m,
             parents,
