@@ -54,7 +54,7 @@ impl SphereProjector {
         let b = n.dot(offset);
         let c = offset.length_squared() - self.radius * self.radius;
         let discriminant = b * b - c;
-        if !(discriminant >= 0.0) || !p.is_finite() || !n.is_finite() {
+        if discriminant.is_nan() || discriminant < 0.0 || !p.is_finite() || !n.is_finite() {
             return None;
         }
         let root = discriminant.sqrt();

@@ -20,6 +20,9 @@ use std::ops::Range;
 
 use super::winding::{TriangleIndexError, check_triangle_indices};
 
+/// Barycentrics and local sub-triangles of one grid, as returned by [`face_grid`].
+type FaceGrid = (Vec<[f64; 3]>, Vec<[u32; 3]>);
+
 /// Options of [`regular_samples`] (spec §3.3, Verification note 7).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct RegularSamplingOptions {
@@ -188,7 +191,7 @@ pub fn round_grid_size(n_cont: f64, min_n: u32, max_n: u32, rng: &mut impl Rng) 
     if n_cont >= (max_n - 1) as f64 {
         return max_n;
     }
-    if !(n_cont >= min_n as f64) {
+    if n_cont.is_nan() || n_cont < min_n as f64 {
         return min_n;
     }
     let k = n_cont.floor();
@@ -255,7 +258,7 @@ pub fn regular_samples(
     out.sub_triangle_faces.reserve(sub_count);
 
     // Grids are cached per size: there are at most `max_n` distinct ones.
-    let mut grids: Vec<Option<(Vec<[f64; 3]>, Vec<[u32; 3]>)>> = Vec::new();
+    let mut grids: Vec<Option<FaceGrid>> = Vec::new();
     for (f, tri) in triangles.iter().enumerate() {
         let n = out.face_n[f] as usize;
         if grids.len() <= n {
