@@ -12,7 +12,7 @@
 //! expansion centre is farther than `β × radius` from the query is evaluated by its expansion;
 //! nearer nodes are opened, and leaves are summed exactly.
 
-use glam::DVec3;
+use glam::{DMat3, DVec3};
 use rayon::prelude::*;
 use std::f64::consts::PI;
 
@@ -124,9 +124,22 @@ struct Node {
     normal_sum: DVec3,
     /// Order-2 coefficient: Σ area · n ⊗ (centroid − center), row i = n_i.
     second: [DVec3; 3],
+    /// Order-3 coefficient: `third[i]` = Σ n_i ∫ u uᵀ dA (symmetric), u = x − center.
+    third: [DMat3; 3],
     start: u32,
     end: u32,
     /// Index of the second child (the first is `self + 1`); 0 for a leaf.
+    right: u32,
+}
+
+/// The part of a node the traversal reads for every visited node, kept apart from the (large)
+/// expansion coefficients so the traversal stays in cache.
+#[derive(Debug, Clone, Copy)]
+struct NodeBounds {
+    center: DVec3,
+    far_distance_sq: f64,
+    start: u32,
+    end: u32,
     right: u32,
 }
 
@@ -139,6 +152,8 @@ struct Node {
 /// worst case against [`exact_winding_number`].
 #[derive(Debug, Clone)]
 pub struct WindingNumber {
+    bounds: Vec<NodeBounds>,
+    /// Full nodes (expansion coefficients), same indexing as `bounds`.
     nodes: Vec<Node>,
     /// Triangle corners in hierarchy order.
     corners: Vec<[DVec3; 3]>,
@@ -189,7 +204,21 @@ impl WindingNumber {
         for node in &mut nodes {
             fill_expansion(node, &corners, &centroids, beta);
         }
-        Ok(Self { nodes, corners })
+        let bounds = nodes
+            .iter()
+            .map(|n| NodeBounds {
+                center: n.center,
+                far_distance_sq: n.far_distance_sq,
+                start: n.start,
+                end: n.end,
+                right: n.right,
+            })
+            .collect();
+        Ok(Self {
+            bounds,
+            nodes,
+            corners,
+        })
     }
 
     /// Number of triangles in the soup.
@@ -207,11 +236,11 @@ impl WindingNumber {
         let mut stack: Vec<u32> = Vec::with_capacity(64);
         stack.push(0);
         while let Some(index) = stack.pop() {
-            let node = &self.nodes[index as usize];
+            let node = &self.bounds[index as usize];
             let r = node.center - p;
             let d2 = r.length_squared();
             if d2 > node.far_distance_sq {
-                total += far_field(node, r, d2);
+                total += far_field(&self.nodes[index as usize], r, d2);
             } else if node.right == 0 {
                 for c in &self.corners[node.start as usize..node.end as usize] {
                     total += triangle_solid_angle(p, c[0], c[1], c[2]);
@@ -255,7 +284,21 @@ fn far_field(node: &Node, r: DVec3, d2: f64) -> f64 {
     let trace = m[0].x + m[1].y + m[2].z;
     let r_m_r = r.x * m[0].dot(r) + r.y * m[1].dot(r) + r.z * m[2].dot(r);
     let order2 = trace * inv_d3 - 3.0 * r_m_r * inv_d5;
-    order1 + order2
+    // Order 3: ½ H : T with H_ijk = ∂²f_i/∂x_j∂x_k
+    //   = −3(δ_ij r_k + δ_ik r_j + δ_jk r_i)/d⁵ + 15 r_i r_j r_k/d⁷,
+    // T_ijk = Σ ∫ n_i u_j u_k dA (node.third[i] is the symmetric matrix T_i··).
+    let t = &node.third;
+    let diagonal_rows = t[0].col(0).dot(r) + t[1].col(1).dot(r) + t[2].col(2).dot(r);
+    let traces = r.x * mat_trace(&t[0]) + r.y * mat_trace(&t[1]) + r.z * mat_trace(&t[2]);
+    let cubic = r.x * r.dot(t[0] * r) + r.y * r.dot(t[1] * r) + r.z * r.dot(t[2] * r);
+    let order3 =
+        0.5 * (-3.0 * (2.0 * diagonal_rows + traces) * inv_d5 + 15.0 * cubic * inv_d5 / d2);
+    order1 + order2 + order3
+}
+
+#[inline]
+fn mat_trace(m: &DMat3) -> f64 {
+    m.x_axis.x + m.y_axis.y + m.z_axis.z
 }
 
 /// Builds the subtree over `order[start..start+len]` (indices relative to the whole `order`),
@@ -274,6 +317,7 @@ fn build_node(
         far_distance_sq: 0.0,
         normal_sum: DVec3::ZERO,
         second: [DVec3::ZERO; 3],
+        third: [DMat3::ZERO; 3],
         start: offset as u32,
         end: (offset + order.len()) as u32,
         right: 0,
@@ -328,6 +372,7 @@ fn fill_expansion(node: &mut Node, corners: &[[DVec3; 3]], centroids: &[DVec3], 
         centroids[range.clone()].iter().copied().sum::<DVec3>() / range.len() as f64
     };
     let mut second = [DVec3::ZERO; 3];
+    let mut third = [DMat3::ZERO; 3];
     let mut radius_sq: f64 = 0.0;
     for (c, &g) in corners[range.clone()].iter().zip(&centroids[range.clone()]) {
         let an = 0.5 * (c[1] - c[0]).cross(c[2] - c[0]);
@@ -335,6 +380,15 @@ fn fill_expansion(node: &mut Node, corners: &[[DVec3; 3]], centroids: &[DVec3], 
         second[0] += an.x * u;
         second[1] += an.y * u;
         second[2] += an.z * u;
+        // ∫_t u uᵀ dA / area = u_g u_gᵀ + (1/12) Σ_k (v_k − g)(v_k − g)ᵀ (exact for a triangle).
+        let mut moment = DMat3::from_cols(u * u.x, u * u.y, u * u.z);
+        for v in c {
+            let e = *v - g;
+            moment += DMat3::from_cols(e * e.x, e * e.y, e * e.z) * (1.0 / 12.0);
+        }
+        third[0] += moment * an.x;
+        third[1] += moment * an.y;
+        third[2] += moment * an.z;
         for v in c {
             radius_sq = radius_sq.max(v.distance_squared(center));
         }
@@ -342,6 +396,7 @@ fn fill_expansion(node: &mut Node, corners: &[[DVec3; 3]], centroids: &[DVec3], 
     node.center = center;
     node.normal_sum = normal_sum;
     node.second = second;
+    node.third = third;
     // NaN (non-finite input) compares false in `d2 > far`, so such nodes are always opened.
     node.far_distance_sq = beta * beta * radius_sq;
 }
