@@ -289,3 +289,34 @@ fn sample_count_tracks_area_over_density_squared() {
     let expected = 0.5 * doubled_area / (d * density).powi(2);
     assert!((n * (n + 1.0) / 2.0 - expected).abs() < 1e-9);
 }
+
+#[test]
+fn samples_of_an_inscribed_face_project_onto_the_reference_sphere() {
+    use roar_mesh::spatial::{Projector, SphereProjector};
+    // A face with its corners on the unit sphere; vertex normals radial.
+    let p = vec![
+        DVec3::new(1.0, 0.0, 0.0),
+        DVec3::new(0.0, 1.0, 0.0),
+        DVec3::new(0.0, 0.0, 1.0),
+    ];
+    let normals = p.clone();
+    let mut rng = ChaCha8Rng::seed_from_u64(0);
+    let options = RegularSamplingOptions {
+        density: 0.1,
+        ..Default::default()
+    };
+    let s = regular_samples(&p, &[[0, 1, 2]], Some(&normals), &options, &mut rng).unwrap();
+    let sphere = SphereProjector {
+        center: DVec3::ZERO,
+        radius: 1.0,
+    };
+    let projected = sphere.project(&p, &[[0, 1, 2]], &s.points, &s.normals);
+    assert_eq!(projected.len(), s.points.len());
+    for (i, q) in projected.iter().enumerate() {
+        let q = q.expect("every sample of an inscribed face hits the sphere");
+        assert!((q.length() - 1.0).abs() < 1e-12);
+        // Moves outward (samples lie inside the sphere) along the sample normal.
+        assert!((q - s.points[i]).dot(s.normals[i]) >= -1e-12);
+        assert!((q - s.points[i]).cross(s.normals[i]).length() < 1e-12);
+    }
+}
