@@ -27,11 +27,11 @@ type FaceGrid = (Vec<[f64; 3]>, Vec<[u32; 3]>);
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct RegularSamplingOptions {
     /// Sampling density δ as a fraction of the bounding-box diagonal D of the sampled mesh: a face
-    /// gets about `A_f / (δD)²` samples. Default 0.002 (spec §3.3 step 1, [SUP]).
+    /// gets about `A_f / (δD)²` samples. Default 0.002 (spec §3.3 step 1, the supplementary).
     pub density: f64,
     /// Per-face cap on the grid size `n` (points per side). Default 16, i.e. 136 samples, the
     /// reference code's effective cap (`max_samples = 20`, Verification note 7 / OQ-6).
-    /// [SUP]'s "420 samples" reading would be 28.
+    /// The supplementary's "420 samples" reading would be 28.
     pub max_n: u32,
     /// Minimum grid size, used when the area calls for fewer points. Default 3 (6 samples, the
     /// fewest that measure curvature; spec §3.3 step 3). Values below 2 are treated as 2.
