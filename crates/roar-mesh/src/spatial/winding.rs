@@ -266,12 +266,51 @@ impl WindingNumber {
         if points.len() <= CHUNK {
             return points.iter().map(|&p| self.winding_number(p)).collect();
         }
-        points
+        // Visit the points in Morton order so consecutive queries walk the same part of the
+        // tree (cache locality); values are independent of the visiting order.
+        let order = morton_order(points);
+        let sorted: Vec<f64> = order
             .par_iter()
             .with_min_len(CHUNK)
-            .map(|&p| self.winding_number(p))
-            .collect()
+            .map(|&i| self.winding_number(points[i as usize]))
+            .collect();
+        let mut values = vec![0.0; points.len()];
+        for (&i, &w) in order.iter().zip(&sorted) {
+            values[i as usize] = w;
+        }
+        values
     }
+}
+
+/// Indices of `points` sorted by the Morton code of their position in the points' bounding box
+/// (non-finite points first); a stable sort, so the order is deterministic.
+fn morton_order(points: &[DVec3]) -> Vec<u32> {
+    let mut lo = DVec3::splat(f64::INFINITY);
+    let mut hi = DVec3::splat(f64::NEG_INFINITY);
+    for p in points.iter().filter(|p| p.is_finite()) {
+        lo = lo.min(*p);
+        hi = hi.max(*p);
+    }
+    let scale = (hi - lo).max_element();
+    let scale = if scale > 0.0 { 1023.0 / scale } else { 0.0 };
+    let spread = |v: u64| {
+        // Spread the 10 low bits of v so there are two zero bits between each.
+        let mut x = v & 0x3ff;
+        x = (x | (x << 16)) & 0x0300_00ff;
+        x = (x | (x << 8)) & 0x0300_f00f;
+        x = (x | (x << 4)) & 0x030c_30c3;
+        (x | (x << 2)) & 0x0924_9249
+    };
+    let key = |p: &DVec3| -> u64 {
+        if !p.is_finite() {
+            return 0;
+        }
+        let c = ((*p - lo) * scale).clamp(DVec3::ZERO, DVec3::splat(1023.0));
+        spread(c.x as u64) | (spread(c.y as u64) << 1) | (spread(c.z as u64) << 2)
+    };
+    let mut order: Vec<u32> = (0..points.len() as u32).collect();
+    order.sort_by_cached_key(|&i| key(&points[i as usize]));
+    order
 }
 
 /// Far-field evaluation of one node: 4π × (its winding number contribution), from the Taylor
