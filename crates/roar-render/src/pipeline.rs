@@ -1,0 +1,457 @@
+//! The per-view pipeline (project → rasterize → antialias → shade) and its backward pass, run
+//! over all views with rayon and reduced in view order.
+
+use glam::{DMat4, DVec3};
+use rayon::prelude::*;
+
+use crate::antialias::{AaItem, antialias_items, crossing_grad, pixel_centre};
+use crate::camera::{Camera, ProjectedVertex, project_backward, project_with};
+use crate::loss::{LossKind, loss_term};
+use crate::normals::{face_normal_backward, face_normals};
+use crate::raster::rasterize;
+use crate::topology::EdgeNeighbors;
+use crate::{BACKGROUND, RenderError, RenderOptions};
+
+/// An RGBA image, row-major, row 0 at the top; RGB is a raw normal in \[−1, 1\], A coverage.
+pub type Image = Vec<[f32; 4]>;
+
+/// Views processed together before their gradients are summed (bounds memory; the sum order is
+/// the view order whatever the thread count).
+const VIEW_CHUNK: usize = 8;
+
+/// Everything one view's forward pass produced.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ViewRender {
+    /// Image width in pixels.
+    pub width: u32,
+    /// Image height in pixels.
+    pub height: u32,
+    /// Visible triangle per pixel ([`BACKGROUND`] where empty).
+    pub ids: Vec<u32>,
+    /// NDC depth `z/w` per pixel (`+∞` where empty).
+    pub depth: Vec<f32>,
+    /// Antialiased colour: raw face normal and coverage; background 0.
+    pub rgba: Image,
+    /// Antialiasing blends, sorted by target pixel (empty when antialiasing is off).
+    pub aa: Vec<AaItem>,
+}
+
+/// The forward pass over all cameras.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Renders {
+    /// One render per camera, in camera order.
+    pub views: Vec<ViewRender>,
+    /// Number of triangles rendered (length of [`face_pixel_counts`]).
+    pub num_faces: usize,
+}
+
+fn validate(
+    positions: &[DVec3],
+    triangles: &[[u32; 3]],
+    cameras: &[Camera],
+) -> Result<(), RenderError> {
+    if let Some(vertex) = positions.iter().position(|p| !p.is_finite()) {
+        return Err(RenderError::NonFiniteVertex { vertex });
+    }
+    for (face, t) in triangles.iter().enumerate() {
+        if let Some(&vertex) = t.iter().find(|&&i| i as usize >= positions.len()) {
+            return Err(RenderError::IndexOutOfRange {
+                face,
+                vertex,
+                num_vertices: positions.len(),
+            });
+        }
+    }
+    for (camera, c) in cameras.iter().enumerate() {
+        if c.width == 0 || c.height == 0 {
+            return Err(RenderError::EmptyResolution {
+                camera,
+                width: c.width,
+                height: c.height,
+            });
+        }
+    }
+    Ok(())
+}
+
+fn project_view(
+    positions: &[DVec3],
+    cam: &Camera,
+    camera: usize,
+) -> Result<Vec<ProjectedVertex>, RenderError> {
+    let m = cam.view_proj();
+    positions
+        .iter()
+        .enumerate()
+        .map(|(vertex, &p)| {
+            let v = project_with(&m, cam.width, cam.height, p);
+            if v.w < crate::camera::NEAR || !v.x.is_finite() || !v.y.is_finite() {
+                Err(RenderError::BehindNearPlane { vertex, camera })
+            } else {
+                Ok(v)
+            }
+        })
+        .collect()
+}
+
+/// The part of a view's forward pass that backward needs.
+struct ViewGeometry {
+    verts: Vec<ProjectedVertex>,
+    ids: Vec<u32>,
+    depth: Vec<f32>,
+    items: Vec<AaItem>,
+}
+
+fn forward_view(
+    positions: &[DVec3],
+    triangles: &[[u32; 3]],
+    neighbors: &EdgeNeighbors,
+    cam: &Camera,
+    camera: usize,
+    opts: &RenderOptions,
+) -> Result<ViewGeometry, RenderError> {
+    let verts = project_view(positions, cam, camera)?;
+    let raster = rasterize(
+        &verts,
+        triangles,
+        cam.width,
+        cam.height,
+        opts.cull_backfaces,
+    );
+    let items = if opts.antialias {
+        antialias_items(
+            &verts,
+            triangles,
+            neighbors,
+            &raster.ids,
+            &raster.depth,
+            cam.width,
+            cam.height,
+        )
+    } else {
+        Vec::new()
+    };
+    Ok(ViewGeometry {
+        verts,
+        ids: raster.ids,
+        depth: raster.depth,
+        items,
+    })
+}
+
+#[inline]
+fn colour(normals: &[DVec3], id: u32) -> [f64; 4] {
+    if id == BACKGROUND {
+        [0.0; 4]
+    } else {
+        let n = normals[id as usize];
+        [n.x, n.y, n.z, 1.0]
+    }
+}
+
+/// Visits every pixel in order with its antialiased colour and the AA items targeting it.
+fn shade_view(
+    ids: &[u32],
+    items: &[AaItem],
+    normals: &[DVec3],
+    mut visit: impl FnMut(usize, [f64; 4], &[AaItem]),
+) {
+    let mut next = 0;
+    for (p, &id) in ids.iter().enumerate() {
+        let base = colour(normals, id);
+        let start = next;
+        let mut img = base;
+        while next < items.len() && items[next].target as usize == p {
+            let it = &items[next];
+            let src = colour(normals, ids[it.source as usize]);
+            for c in 0..4 {
+                img[c] += it.alpha * (src[c] - base[c]);
+            }
+            next += 1;
+        }
+        visit(p, img, &items[start..next]);
+    }
+}
+
+/// Per-view gradient: summed loss, dL/d(face normal) per face, and position gradients of the
+/// silhouette vertices in item order.
+struct ViewGrad {
+    loss: f64,
+    d_normals: Vec<DVec3>,
+    d_positions: Vec<(u32, DVec3)>,
+}
+
+/// Backward of one view given a seed `seed(pixel, colour) -> dL/dI` (which may also accumulate
+/// a loss).
+fn backward_view(
+    geom: &ViewGeometry,
+    cam: &Camera,
+    normals: &[DVec3],
+    mut seed: impl FnMut(usize, [f64; 4]) -> [f64; 4],
+) -> ViewGrad {
+    let m: DMat4 = cam.view_proj();
+    let mut d_normals = vec![DVec3::ZERO; normals.len()];
+    let mut d_positions = Vec::new();
+    let ids = &geom.ids;
+    shade_view(ids, &geom.items, normals, |p, img, items| {
+        let g = seed(p, img);
+        if g == [0.0; 4] {
+            return;
+        }
+        let gn = DVec3::new(g[0], g[1], g[2]);
+        let id = ids[p];
+        let base = colour(normals, id);
+        let mut own = 1.0;
+        for it in items {
+            own -= it.alpha;
+            let src_id = ids[it.source as usize];
+            let src = colour(normals, src_id);
+            if src_id != BACKGROUND {
+                d_normals[src_id as usize] += gn * it.alpha;
+            }
+            let d_alpha: f64 = (0..4).map(|c| g[c] * (src[c] - base[c])).sum();
+            let d_t = d_alpha * it.dalpha_dt;
+            if d_t == 0.0 {
+                continue;
+            }
+            let (front, other) = it.pixels();
+            let [a, b] = it.edge;
+            let (va, vb) = (&geom.verts[a as usize], &geom.verts[b as usize]);
+            let dt = crossing_grad(
+                [va.x, va.y],
+                [vb.x, vb.y],
+                pixel_centre(front, cam.width),
+                pixel_centre(other, cam.width),
+            );
+            d_positions.push((
+                a,
+                project_backward(&m, cam.width, cam.height, va, d_t * dt[0], d_t * dt[1]),
+            ));
+            d_positions.push((
+                b,
+                project_backward(&m, cam.width, cam.height, vb, d_t * dt[2], d_t * dt[3]),
+            ));
+        }
+        if id != BACKGROUND {
+            d_normals[id as usize] += gn * own;
+        }
+    });
+    ViewGrad {
+        loss: 0.0,
+        d_normals,
+        d_positions,
+    }
+}
+
+/// Renders `triangles` over `positions` from every camera.
+///
+/// Inputs: vertex positions (normalized into the rig's sphere), triangles as vertex index
+/// triples (any soup: repeated, flipped or degenerate faces are fine), cameras. Output: per view
+/// the id and depth buffers, the antialiased RGBA image and the AA items.
+/// Errors: non-finite vertices, out-of-range indices, empty resolutions, vertices behind a
+/// camera's near plane.
+pub fn render(
+    positions: &[DVec3],
+    triangles: &[[u32; 3]],
+    cameras: &[Camera],
+    opts: &RenderOptions,
+) -> Result<Renders, RenderError> {
+    validate(positions, triangles, cameras)?;
+    let neighbors = EdgeNeighbors::new(triangles);
+    let normals = face_normals(positions, triangles);
+    let views = cameras
+        .par_iter()
+        .enumerate()
+        .map(|(ci, cam)| {
+            let geom = forward_view(positions, triangles, &neighbors, cam, ci, opts)?;
+            let mut rgba = Vec::with_capacity(geom.ids.len());
+            shade_view(&geom.ids, &geom.items, &normals, |_, img, _| {
+                rgba.push(img.map(|c| c as f32));
+            });
+            Ok(ViewRender {
+                width: cam.width,
+                height: cam.height,
+                ids: geom.ids,
+                depth: geom.depth,
+                rgba,
+                aa: geom.items,
+            })
+        })
+        .collect::<Result<Vec<_>, RenderError>>()?;
+    Ok(Renders {
+        views,
+        num_faces: triangles.len(),
+    })
+}
+
+/// Sums per-view gradients in view order and back-propagates the face-normal gradients once.
+fn reduce_views(
+    positions: &[DVec3],
+    triangles: &[[u32; 3]],
+    num_views: usize,
+    per_view: impl Fn(usize) -> Result<ViewGrad, RenderError> + Sync,
+) -> Result<(f64, Vec<DVec3>), RenderError> {
+    let mut loss = 0.0;
+    let mut d_normals = vec![DVec3::ZERO; triangles.len()];
+    let mut grad = vec![DVec3::ZERO; positions.len()];
+    let mut aa_grads = Vec::new();
+    let indices: Vec<usize> = (0..num_views).collect();
+    for chunk in indices.chunks(VIEW_CHUNK) {
+        let results = chunk
+            .par_iter()
+            .map(|&v| per_view(v))
+            .collect::<Result<Vec<_>, RenderError>>()?;
+        for r in results {
+            loss += r.loss;
+            for (acc, d) in d_normals.iter_mut().zip(&r.d_normals) {
+                *acc += *d;
+            }
+            aa_grads.push(r.d_positions);
+        }
+    }
+    for (t, &g_n) in triangles.iter().zip(&d_normals) {
+        if g_n == DVec3::ZERO {
+            continue;
+        }
+        let [i0, i1, i2] = t.map(|i| i as usize);
+        let g = face_normal_backward(positions[i0], positions[i1], positions[i2], g_n);
+        grad[i0] += g[0];
+        grad[i1] += g[1];
+        grad[i2] += g[2];
+    }
+    for view in aa_grads {
+        for (v, g) in view {
+            grad[v as usize] += g;
+        }
+    }
+    Ok((loss, grad))
+}
+
+/// Backward pass of [`render`]: given `dL/dI` per view and pixel (RGBA), returns `dL/dV` per
+/// vertex, through the face normals of covered pixels and through the antialiasing crossings of
+/// silhouette and occlusion edges. `renders` must come from [`render`] with the same inputs.
+pub fn backward(
+    positions: &[DVec3],
+    triangles: &[[u32; 3]],
+    cameras: &[Camera],
+    renders: &Renders,
+    d_image: &[Vec<[f64; 4]>],
+) -> Result<Vec<DVec3>, RenderError> {
+    validate(positions, triangles, cameras)?;
+    if renders.views.len() != cameras.len() || d_image.len() != cameras.len() {
+        return Err(RenderError::ShapeMismatch {
+            what: format!(
+                "{} cameras, {} renders, {} image gradients",
+                cameras.len(),
+                renders.views.len(),
+                d_image.len()
+            ),
+        });
+    }
+    for (i, (view, cam)) in renders.views.iter().zip(cameras).enumerate() {
+        if view.ids.len() != cam.num_pixels() || d_image[i].len() != cam.num_pixels() {
+            return Err(RenderError::ShapeMismatch {
+                what: format!("view {i}: buffer sizes differ from the camera's resolution"),
+            });
+        }
+    }
+    let normals = face_normals(positions, triangles);
+    let (_, grad) = reduce_views(positions, triangles, cameras.len(), |v| {
+        let cam = &cameras[v];
+        let view = &renders.views[v];
+        let geom = ViewGeometry {
+            verts: project_view(positions, cam, v)?,
+            ids: view.ids.clone(),
+            depth: Vec::new(),
+            items: view.aa.clone(),
+        };
+        let d = &d_image[v];
+        Ok(backward_view(&geom, cam, &normals, |p, _| d[p]))
+    })?;
+    Ok(grad)
+}
+
+/// The fused path the optimizer uses: renders every view, compares it with `targets` (one image
+/// per camera), and returns the mean image loss and `dL/dV`, without keeping any view's buffers
+/// after it is done. Colours, blends and gradients are computed in f64 (targets are f32).
+pub fn render_loss_and_grad(
+    positions: &[DVec3],
+    triangles: &[[u32; 3]],
+    cameras: &[Camera],
+    targets: &[Image],
+    opts: &RenderOptions,
+    kind: LossKind,
+) -> Result<(f64, Vec<DVec3>), RenderError> {
+    validate(positions, triangles, cameras)?;
+    if targets.len() != cameras.len() {
+        return Err(RenderError::ShapeMismatch {
+            what: format!("{} cameras but {} targets", cameras.len(), targets.len()),
+        });
+    }
+    for (i, (t, cam)) in targets.iter().zip(cameras).enumerate() {
+        if t.len() != cam.num_pixels() {
+            return Err(RenderError::ShapeMismatch {
+                what: format!(
+                    "target {i} has {} pixels, camera {}",
+                    t.len(),
+                    cam.num_pixels()
+                ),
+            });
+        }
+    }
+    let total: usize = cameras.iter().map(|c| c.num_pixels() * 4).sum();
+    let inv_n = if total > 0 { 1.0 / total as f64 } else { 0.0 };
+    let neighbors = EdgeNeighbors::new(triangles);
+    let normals = face_normals(positions, triangles);
+    let (loss, grad) = reduce_views(positions, triangles, cameras.len(), |v| {
+        let cam = &cameras[v];
+        let geom = forward_view(positions, triangles, &neighbors, cam, v, opts)?;
+        let target = &targets[v];
+        let mut loss = 0.0;
+        let mut r = backward_view(&geom, cam, &normals, |p, img| {
+            let t = target[p];
+            let mut g = [0.0; 4];
+            for c in 0..4 {
+                let (l, d) = loss_term(kind, img[c] - t[c] as f64);
+                loss += l;
+                g[c] = d * inv_n;
+            }
+            g
+        });
+        r.loss = loss;
+        Ok(r)
+    })?;
+    Ok((loss * inv_n, grad))
+}
+
+/// Number of pixels, over all views, in which each face is the visible triangle (before
+/// antialiasing). Used by the soup orientation clean-up (spec §3.1(a) step 3) with culling on.
+pub fn face_pixel_counts(renders: &Renders) -> Vec<u32> {
+    let mut counts = vec![0u32; renders.num_faces];
+    for view in &renders.views {
+        for &id in &view.ids {
+            if id != BACKGROUND {
+                counts[id as usize] += 1;
+            }
+        }
+    }
+    counts
+}
+
+/// Maps a rendered image to 8-bit RGBA for dumps: RGB = `(n + 1)/2`, A = coverage, both
+/// clamped to \[0, 1\]. Background pixels (A = 0) map to transparent black.
+pub fn to_rgba8(image: &[[f32; 4]]) -> Vec<u8> {
+    let q = |v: f32| (v.clamp(0.0, 1.0) * 255.0).round() as u8;
+    let mut out = Vec::with_capacity(image.len() * 4);
+    for px in image {
+        if px[3] == 0.0 {
+            out.extend_from_slice(&[0, 0, 0, 0]);
+        } else {
+            for c in 0..3 {
+                out.push(q((px[c] + 1.0) * 0.5));
+            }
+            out.push(q(px[3]));
+        }
+    }
+    out
+}

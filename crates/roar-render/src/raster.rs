@@ -1,0 +1,138 @@
+//! Watertight z-buffered rasterization of one view.
+//!
+//! Vertices are snapped to 1/256 pixel and edge functions are evaluated exactly in `i64` at pixel
+//! centres, stepped incrementally over each triangle's clamped bounding box. A pixel centre lying
+//! exactly on an edge belongs to the triangle for which the tie rule (equivalent to moving the
+//! sample point by an infinitesimal in a fixed direction, i.e. a top-left rule) says so, hence two
+//! triangles sharing an edge never both cover, nor both miss, a pixel. Depth is the NDC `z/w`,
+//! affine in screen space, evaluated in `f32`; ties break on the triangle's vertex indices, so the
+//! result does not depend on the order of the triangle list.
+
+use crate::BACKGROUND;
+use crate::camera::ProjectedVertex;
+
+/// Sub-pixel resolution of the fixed-point vertex snap (bits).
+const SUBPIXEL_BITS: u32 = 8;
+const ONE: i64 = 1 << SUBPIXEL_BITS;
+const HALF: i64 = ONE / 2;
+
+/// The id and depth buffers of one view, row-major, row 0 at the top.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RasterBuffers {
+    /// Visible triangle per pixel, [`BACKGROUND`] where empty.
+    pub ids: Vec<u32>,
+    /// NDC depth `z/w` of the visible triangle, `+∞` where empty.
+    pub depth: Vec<f32>,
+}
+
+/// Whether a triangle with this pixel-space signed area (`cross(p1 − p0, p2 − p0)`, y down)
+/// faces the camera (counter-clockwise seen from the camera).
+pub fn is_front_facing(signed_area: f64) -> bool {
+    signed_area < 0.0
+}
+
+fn snap(v: f64) -> i64 {
+    (v * ONE as f64).round() as i64
+}
+
+fn floor_div(a: i64, b: i64) -> i64 {
+    a.div_euclid(b)
+}
+
+fn ceil_div(a: i64, b: i64) -> i64 {
+    -((-a).div_euclid(b))
+}
+
+/// Rasterizes `triangles` over `verts` (already projected, all in front of the near plane).
+pub fn rasterize(
+    verts: &[ProjectedVertex],
+    triangles: &[[u32; 3]],
+    width: u32,
+    height: u32,
+    cull_backfaces: bool,
+) -> RasterBuffers {
+    let (w, h) = (width as usize, height as usize);
+    let mut ids = vec![BACKGROUND; w * h];
+    let mut depth = vec![f32::INFINITY; w * h];
+    // Snap once per vertex so shared edges get identical fixed-point endpoints.
+    let snapped: Vec<[i64; 2]> = verts.iter().map(|v| [snap(v.x), snap(v.y)]).collect();
+    let max_x = w as i64 - 1;
+    let max_y = h as i64 - 1;
+    for (f, tri) in triangles.iter().enumerate() {
+        let [i0, i1, i2] = tri.map(|i| i as usize);
+        let (q0, q1, q2) = (snapped[i0], snapped[i1], snapped[i2]);
+        let area = (q1[0] - q0[0]) * (q2[1] - q0[1]) - (q1[1] - q0[1]) * (q2[0] - q0[0]);
+        if area == 0 || (cull_backfaces && area > 0) {
+            continue;
+        }
+        // Orient so that inside means all three edge functions are positive.
+        let corners = if area > 0 { [q0, q1, q2] } else { [q0, q2, q1] };
+        let min_x = corners.iter().map(|c| c[0]).min().unwrap_or(0);
+        let max_cx = corners.iter().map(|c| c[0]).max().unwrap_or(0);
+        let min_y = corners.iter().map(|c| c[1]).min().unwrap_or(0);
+        let max_cy = corners.iter().map(|c| c[1]).max().unwrap_or(0);
+        let x0 = ceil_div(min_x - HALF, ONE).max(0);
+        let x1 = floor_div(max_cx - HALF, ONE).min(max_x);
+        let y0 = ceil_div(min_y - HALF, ONE).max(0);
+        let y1 = floor_div(max_cy - HALF, ONE).min(max_y);
+        if x0 > x1 || y0 > y1 {
+            continue;
+        }
+        // Edge functions E(p) = cross(b − a, p − a), biased by the tie rule, at the first centre.
+        let px0 = x0 * ONE + HALF;
+        let py0 = y0 * ONE + HALF;
+        let mut row = [0i64; 3];
+        let mut step_x = [0i64; 3];
+        let mut step_y = [0i64; 3];
+        for k in 0..3 {
+            let a = corners[k];
+            let b = corners[(k + 1) % 3];
+            let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
+            let include_ties = dy > 0 || (dy == 0 && dx < 0);
+            let bias = if include_ties { 0 } else { -1 };
+            row[k] = dx * (py0 - a[1]) - dy * (px0 - a[0]) + bias;
+            step_x[k] = -dy * ONE;
+            step_y[k] = dx * ONE;
+        }
+        // Depth plane z = z0 + zx (x − x0) + zy (y − y0) in float pixel coordinates.
+        let (v0, v1, v2) = (&verts[i0], &verts[i1], &verts[i2]);
+        let (d1x, d1y, d1z) = (v1.x - v0.x, v1.y - v0.y, v1.z - v0.z);
+        let (d2x, d2y, d2z) = (v2.x - v0.x, v2.y - v0.y, v2.z - v0.z);
+        let det = d1x * d2y - d1y * d2x;
+        let (zx, zy) = if det != 0.0 {
+            ((d1z * d2y - d2z * d1y) / det, (d2z * d1x - d1z * d2x) / det)
+        } else {
+            (0.0, 0.0)
+        };
+        let z_origin = v0.z + zx * (x0 as f64 + 0.5 - v0.x) + zy * (y0 as f64 + 0.5 - v0.y);
+        let (zx32, zy32, zo32) = (zx as f32, zy as f32, z_origin as f32);
+        let fid = f as u32;
+        for y in y0..=y1 {
+            let mut e = row;
+            let z_row = zo32 + zy32 * (y - y0) as f32;
+            let base = y as usize * w;
+            for x in x0..=x1 {
+                if (e[0] | e[1] | e[2]) >= 0 {
+                    let z = z_row + zx32 * (x - x0) as f32;
+                    let p = base + x as usize;
+                    let cur = depth[p];
+                    if z < cur
+                        || (z == cur
+                            && ids[p] != BACKGROUND
+                            && triangles[fid as usize] < triangles[ids[p] as usize])
+                    {
+                        depth[p] = z;
+                        ids[p] = fid;
+                    }
+                }
+                e[0] += step_x[0];
+                e[1] += step_x[1];
+                e[2] += step_x[2];
+            }
+            row[0] += step_y[0];
+            row[1] += step_y[1];
+            row[2] += step_y[2];
+        }
+    }
+    RasterBuffers { ids, depth }
+}
