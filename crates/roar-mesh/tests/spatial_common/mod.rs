@@ -13,7 +13,11 @@ pub fn test_data_dir() -> Option<PathBuf> {
     match std::env::var_os("ROAR_TEST_DATA") {
         Some(dir) => {
             let dir = PathBuf::from(dir);
-            assert!(dir.is_dir(), "ROAR_TEST_DATA={} is not a folder", dir.display());
+            assert!(
+                dir.is_dir(),
+                "ROAR_TEST_DATA={} is not a folder",
+                dir.display()
+            );
             Some(dir)
         }
         None => {
@@ -31,7 +35,10 @@ pub fn test_data_dir() -> Option<PathBuf> {
 pub fn read_mesh(path: &std::path::Path) -> (Vec<DVec3>, Vec<[u32; 3]>) {
     let text = std::fs::read_to_string(path)
         .unwrap_or_else(|e| panic!("cannot read {}: {e}", path.display()));
-    if path.extension().is_some_and(|e| e.eq_ignore_ascii_case("off")) {
+    if path
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("off"))
+    {
         read_off(&text)
     } else {
         read_obj(&text)
@@ -78,21 +85,42 @@ fn read_off(text: &str) -> (Vec<DVec3>, Vec<[u32; 3]>) {
         .lines()
         .map(|l| l.split('#').next().unwrap().trim())
         .filter(|l| !l.is_empty());
-    let mut header = lines.next().unwrap().trim_start_matches("OFF").split_whitespace().peekable();
+    let mut header = lines
+        .next()
+        .unwrap()
+        .trim_start_matches("OFF")
+        .split_whitespace()
+        .peekable();
     let counts: Vec<usize> = if header.peek().is_some() {
         header.map(|t| t.parse().unwrap()).collect()
     } else {
-        lines.next().unwrap().split_whitespace().map(|t| t.parse().unwrap()).collect()
+        lines
+            .next()
+            .unwrap()
+            .split_whitespace()
+            .map(|t| t.parse().unwrap())
+            .collect()
     };
     let positions: Vec<DVec3> = (0..counts[0])
         .map(|_| {
-            let c: Vec<f64> = lines.next().unwrap().split_whitespace().take(3).map(|t| t.parse().unwrap()).collect();
+            let c: Vec<f64> = lines
+                .next()
+                .unwrap()
+                .split_whitespace()
+                .take(3)
+                .map(|t| t.parse().unwrap())
+                .collect();
             DVec3::new(c[0], c[1], c[2])
         })
         .collect();
     let mut triangles = Vec::new();
     for _ in 0..counts[1] {
-        let v: Vec<u32> = lines.next().unwrap().split_whitespace().map(|t| t.parse().unwrap()).collect();
+        let v: Vec<u32> = lines
+            .next()
+            .unwrap()
+            .split_whitespace()
+            .map(|t| t.parse().unwrap())
+            .collect();
         fan(&v[1..=v[0] as usize], &mut triangles);
     }
     (positions, triangles)
