@@ -178,3 +178,55 @@ proptest! {
         }
     }
 }
+
+/// Floating-point Möller interval test, trusted only when nothing is near a tie: returns `None`
+/// if any corner is within `eps` of the other plane or the two intervals nearly touch.
+fn moller_f64(a: [DVec3; 3], b: [DVec3; 3]) -> Option<bool> {
+    const EPS: f64 = 1e-7;
+    let normal = |t: [DVec3; 3]| (t[1] - t[0]).cross(t[2] - t[0]).normalize();
+    let (na, nb) = (normal(a), normal(b));
+    let cut = |t: [DVec3; 3], n: DVec3, o: DVec3| -> Option<Vec<DVec3>> {
+        let d = t.map(|p| n.dot(p - o));
+        if d.iter().any(|x| x.abs() < EPS) {
+            return None;
+        }
+        let mut pts = Vec::new();
+        for i in 0..3 {
+            let (p, q, dp, dq) = (t[i], t[(i + 1) % 3], d[i], d[(i + 1) % 3]);
+            if dp * dq < 0.0 {
+                pts.push(p + (q - p) * (dp / (dp - dq)));
+            }
+        }
+        Some(pts)
+    };
+    let pa = cut(a, nb, b[0])?;
+    let pb = cut(b, na, a[0])?;
+    if pa.is_empty() || pb.is_empty() {
+        return Some(false);
+    }
+    let dir = na.cross(nb);
+    if dir.length() < 1e-3 {
+        return None; // nearly parallel planes
+    }
+    let span = |pts: &[DVec3]| {
+        let s: Vec<f64> = pts.iter().map(|p| dir.dot(*p)).collect();
+        (
+            s.iter().cloned().fold(f64::INFINITY, f64::min),
+            s.iter().cloned().fold(f64::NEG_INFINITY, f64::max),
+        )
+    };
+    let ((a0, a1), (b0, b1)) = (span(&pa), span(&pb));
+    let gap = a0.max(b0) - a1.min(b1);
+    (gap.abs() > EPS).then_some(gap < 0.0)
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(512))]
+
+    #[test]
+    fn generic_triangles_agree_with_a_float_oracle_away_from_ties(a in float_triangle(), b in float_triangle()) {
+        if let Some(expected) = moller_f64(a, b) {
+            prop_assert_eq!(triangles_intersect(a, b), expected);
+        }
+    }
+}
