@@ -148,7 +148,8 @@ impl TriangleBvh {
 
     /// Updates the boxes after the vertices moved; the tree shape is kept (same topology).
     ///
-    /// Input: `positions` (#V), the moved vertices, same length as at build time.
+    /// Input: `positions` (#V), the moved vertices, same length as at build time. A face whose
+    /// corners became non-finite gets a box that overlaps nothing and is no longer reported.
     ///
     /// # Panics
     /// If `positions.len()` differs from the length the tree was built with (a caller bug).
@@ -192,7 +193,10 @@ impl TriangleBvh {
         self.nodes.first().map(|n| n.aabb)
     }
 
-    /// Corners of face `f`. `f` must be a face of the tree.
+    /// Corners of face `f`.
+    ///
+    /// # Panics
+    /// If `f` is not a face of the tree (index out of range of the build buffers).
     pub fn corners(&self, f: u32) -> [DVec3; 3] {
         self.triangles[f as usize].map(|i| self.positions[i as usize])
     }
