@@ -89,6 +89,20 @@ fn check_against_brute_force(
             let hit = bvh.ray_cast(p, dir, t_max);
             let brute = brute_ray_t(positions, triangles, p, dir, t_max);
             assert_eq!(hit.map(|h| h.t), brute, "ray from {p} along {dir}");
+            let all = bvh.ray_cast_all(p, dir, t_max);
+            let mut expected: Vec<(f64, u32)> = triangles
+                .iter()
+                .enumerate()
+                .filter_map(|(f, &t)| {
+                    ray_triangle(p, dir, corners(positions, t)).map(|h| (h.0, f as u32))
+                })
+                .filter(|&(t, _)| t <= t_max)
+                .collect();
+            expected.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+            assert_eq!(
+                all.iter().map(|h| (h.t, h.face)).collect::<Vec<_>>(),
+                expected
+            );
             if let Some(h) = hit {
                 let face = corners(positions, triangles[h.face as usize]);
                 let w = h.barycentric;

@@ -331,6 +331,46 @@ impl TriangleBvh {
         best
     }
 
+    /// Every hit of the ray `origin + t·dir` with `t ∈ (0, t_max]`, sorted by `(t, face)`.
+    ///
+    /// Same hit rule as [`TriangleBvh::ray_cast`]; a ray through a shared edge reports each
+    /// face it touches.
+    pub fn ray_cast_all(&self, origin: DVec3, dir: DVec3, t_max: f64) -> Vec<RayHit> {
+        let mut hits = Vec::new();
+        let Some(root) = self.nodes.first() else {
+            return hits;
+        };
+        let ray = SlabRay::new(origin, dir);
+        let mut stack: Vec<u32> = Vec::with_capacity(64);
+        if ray.enter(&root.aabb, t_max).is_some() {
+            stack.push(0);
+        }
+        while let Some(n) = stack.pop() {
+            let node = &self.nodes[n as usize];
+            if node.is_leaf() {
+                for &f in self.leaf_faces(node) {
+                    if let Some((t, barycentric)) = ray_triangle(origin, dir, self.corners(f))
+                        && t <= t_max
+                    {
+                        hits.push(RayHit {
+                            face: f,
+                            t,
+                            barycentric,
+                        });
+                    }
+                }
+            } else {
+                for child in [node.start + 1, node.start] {
+                    if ray.enter(&self.nodes[child as usize].aabb, t_max).is_some() {
+                        stack.push(child);
+                    }
+                }
+            }
+        }
+        hits.sort_by(|a, b| a.t.total_cmp(&b.t).then(a.face.cmp(&b.face)));
+        hits
+    }
+
     /// Calls `visit(face)` for every face whose box overlaps the closed box `aabb`, in a fixed
     /// order.
     pub fn faces_in_aabb(&self, aabb: &Aabb, mut visit: impl FnMut(u32)) {
