@@ -1,5 +1,118 @@
 //! # roar-loss
 //!
-//! Will own the reconstruction target (the cleaned soup T′, its renders, the oriented point
-//! cloud P) and the losses that drive the vertices: the render loss, the planar projection loss
-//! and, later, the SDF loss, behind a common `Loss` trait.
+//! The reconstruction target (the cleaned soup T′, its renders, the oriented point cloud P) and
+//! the losses that drive the vertices: the render loss and the planar projection loss (spec
+//! §3.1–§3.4), behind the common [`Loss`] trait so a researcher can add or swap a term without
+//! touching the pipeline.
+
+use glam::DVec3;
+
+/// Why a loss could not be evaluated.
+#[derive(Debug, thiserror::Error)]
+pub enum LossError {
+    /// The renderer refused the mesh (e.g. a vertex behind the near plane).
+    #[error("render: {0}")]
+    Render(#[from] roar_render::RenderError),
+    /// The source mesh buffers are unusable (out-of-range index, non-finite position, …).
+    #[error("invalid source mesh: {0}")]
+    InvalidMesh(String),
+    /// The target is unusable (no area, no points, …).
+    #[error("invalid target: {0}")]
+    InvalidTarget(String),
+}
+
+/// A differentiable term of the objective, evaluated on the current source mesh.
+///
+/// Contract: `positions` and `triangles` are a compact closed mesh (every vertex referenced);
+/// the returned gradient has one entry per position. `&mut self` lets a loss keep per-iteration
+/// state (a seeded sample generator, caches); the result must be deterministic for a given call
+/// sequence.
+pub trait Loss: Send {
+    /// Short name for reports and progress lines (e.g. `"render"`, `"planar"`).
+    fn name(&self) -> &'static str;
+    /// The loss value and its gradient with respect to every vertex position.
+    fn value_and_grad(
+        &mut self,
+        positions: &[DVec3],
+        triangles: &[[u32; 3]],
+    ) -> Result<(f64, Vec<DVec3>), LossError>;
+}
+
+/// A weighted sum of losses, itself a [`Loss`] (spec §3.2.3: `3·L_render + 1·L_planar`).
+#[derive(Default)]
+pub struct WeightedSum {
+    /// The terms and their weights, evaluated in this order.
+    pub terms: Vec<(f64, Box<dyn Loss>)>,
+    /// The last evaluation's weighted value of each term (for reports), in term order.
+    pub last_values: Vec<f64>,
+}
+
+impl WeightedSum {
+    /// Adds a term with its weight.
+    pub fn with(mut self, weight: f64, loss: Box<dyn Loss>) -> Self {
+        self.terms.push((weight, loss));
+        self
+    }
+}
+
+impl Loss for WeightedSum {
+    fn name(&self) -> &'static str {
+        "weighted_sum"
+    }
+
+    fn value_and_grad(
+        &mut self,
+        positions: &[DVec3],
+        triangles: &[[u32; 3]],
+    ) -> Result<(f64, Vec<DVec3>), LossError> {
+        let mut total = 0.0;
+        let mut gradient = vec![DVec3::ZERO; positions.len()];
+        self.last_values.clear();
+        for (weight, loss) in &mut self.terms {
+            let (value, grad) = loss.value_and_grad(positions, triangles)?;
+            total += *weight * value;
+            self.last_values.push(*weight * value);
+            for (g, d) in gradient.iter_mut().zip(&grad) {
+                *g += *weight * *d;
+            }
+        }
+        Ok((total, gradient))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// `L = Σ c·|v|²` with gradient `2c·v`.
+    struct Quadratic(f64);
+
+    impl Loss for Quadratic {
+        fn name(&self) -> &'static str {
+            "quadratic"
+        }
+        fn value_and_grad(
+            &mut self,
+            positions: &[DVec3],
+            _: &[[u32; 3]],
+        ) -> Result<(f64, Vec<DVec3>), LossError> {
+            let value = positions.iter().map(|p| self.0 * p.length_squared()).sum();
+            Ok((value, positions.iter().map(|p| 2.0 * self.0 * *p).collect()))
+        }
+    }
+
+    #[test]
+    fn weighted_sum_adds_values_and_gradients_with_weights() {
+        let mut sum = WeightedSum::default()
+            .with(3.0, Box::new(Quadratic(1.0)))
+            .with(0.5, Box::new(Quadratic(2.0)));
+        let positions = [DVec3::new(1.0, 2.0, 0.0), DVec3::new(0.0, 0.0, -1.0)];
+        let (value, grad) = sum.value_and_grad(&positions, &[]).unwrap();
+        // Σ|v|² = 6; 3·6 + 0.5·2·6 = 24.
+        assert_eq!(value, 24.0);
+        assert_eq!(sum.last_values, vec![18.0, 6.0]);
+        // 3·2v + 0.5·4v = 8v.
+        assert_eq!(grad[0], 8.0 * positions[0]);
+        assert_eq!(grad[1], 8.0 * positions[1]);
+    }
+}
