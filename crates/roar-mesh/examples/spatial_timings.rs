@@ -62,21 +62,33 @@ fn main() {
         let (positions, triangles) = spatial_common::read_mesh(&dir.join(&name));
         let (bvh, build) = timed(|| TriangleBvh::build(&positions, &triangles));
 
-        let queries: Vec<DVec3> = {
-            let s = sample_surface(&positions, &triangles, 200_000, 1);
-            let diag = bvh.aabb().map_or(1.0, |b| b.diagonal());
-            s.points
+        // Queries off the surface along the normal by 0.1 % and 1 % of the box diagonal.
+        let samples = sample_surface(&positions, &triangles, 200_000, 1);
+        let diag = bvh.aabb().map_or(1.0, |b| b.diagonal());
+        let offset_queries = |fraction: f64| -> Vec<DVec3> {
+            let lift = fraction * diag;
+            samples
+                .points
                 .iter()
-                .zip(&s.normals)
-                .map(|(p, n)| *p + 0.01 * diag * *n)
+                .zip(&samples.normals)
+                .map(|(p, n)| *p + lift * *n)
                 .collect()
         };
-        let (_, closest) = timed(|| {
-            queries
-                .iter()
-                .map(|&q| bvh.closest_point(q).map_or(0.0, |c| c.distance_squared))
-                .sum::<f64>()
-        });
+        let closest_point_time = |queries: &[DVec3]| {
+            timed(|| {
+                queries
+                    .iter()
+                    .map(|&q| bvh.closest_point(q).map_or(0.0, |c| c.distance_squared))
+                    .sum::<f64>()
+            })
+            .1
+        };
+        let near = closest_point_time(&offset_queries(0.001));
+        let queries = offset_queries(0.01);
+        let closest = format!(
+            "{near} (0.1 % off), {} (1 % off)",
+            closest_point_time(&queries)
+        );
         let (hits, rays) = timed(|| {
             (0..queries.len())
                 .filter(|&k| {

@@ -260,13 +260,18 @@ impl TriangleBvh {
                 let (l, r) = (node.start, node.start + 1);
                 let dl = self.nodes[l as usize].aabb.distance_squared(p);
                 let dr = self.nodes[r as usize].aabb.distance_squared(p);
-                // Push the farther child first so the nearer one is opened first.
-                if dl <= dr {
-                    stack.push((r, dr));
-                    stack.push((l, dl));
+                // Push the farther child first so the nearer one is opened first; children
+                // beyond the best distance so far are never pushed.
+                let (near, far) = if dl <= dr {
+                    ((l, dl), (r, dr))
                 } else {
-                    stack.push((l, dl));
-                    stack.push((r, dr));
+                    ((r, dr), (l, dl))
+                };
+                if far.1 <= best_d2 {
+                    stack.push(far);
+                }
+                if near.1 <= best_d2 {
+                    stack.push(near);
                 }
             }
         }
