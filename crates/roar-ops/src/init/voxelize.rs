@@ -1,0 +1,164 @@
+//! Step 1 and the dilation of step 2 (spec §4, brief "watertight init"): mark every voxel a
+//! triangle touches, with the exact triangle–box overlap test of Akenine-Möller (separating axes).
+
+use super::grid::Grid;
+use glam::DVec3;
+
+/// Whether the triangle `(v0, v1, v2)` overlaps the closed axis-aligned box `center ± half`.
+///
+/// Separating-axis test over the 13 candidate axes (3 box normals, the triangle normal and the 9
+/// edge × box-axis products). Exact up to rounding; callers pass a slightly inflated `half` to make
+/// it conservative. Degenerate triangles are handled (zero axes never separate).
+pub(crate) fn triangle_box_overlap(center: DVec3, half: DVec3, tri: [DVec3; 3]) -> bool {
+    let v = [tri[0] - center, tri[1] - center, tri[2] - center];
+    // Box normals: the triangle's AABB against the box.
+    for a in 0..3 {
+        let lo = v[0][a].min(v[1][a]).min(v[2][a]);
+        let hi = v[0][a].max(v[1][a]).max(v[2][a]);
+        if lo > half[a] || hi < -half[a] {
+            return false;
+        }
+    }
+    let edges = [v[1] - v[0], v[2] - v[1], v[0] - v[2]];
+    let separated = |axis: DVec3| -> bool {
+        let p0 = axis.dot(v[0]);
+        let p1 = axis.dot(v[1]);
+        let p2 = axis.dot(v[2]);
+        let r = half.x * axis.x.abs() + half.y * axis.y.abs() + half.z * axis.z.abs();
+        p0.min(p1).min(p2) > r || p0.max(p1).max(p2) < -r
+    };
+    if separated(edges[0].cross(edges[1])) {
+        return false;
+    }
+    for e in edges {
+        for axis in [DVec3::X, DVec3::Y, DVec3::Z] {
+            if separated(e.cross(axis)) {
+                return false;
+            }
+        }
+    }
+    true
+}
+
+/// Whether the triangle has (numerically) zero area relative to its size.
+pub(crate) fn is_degenerate(tri: [DVec3; 3]) -> bool {
+    let e0 = tri[1] - tri[0];
+    let e1 = tri[2] - tri[0];
+    let area2 = e0.cross(e1).length();
+    let scale = e0
+        .length_squared()
+        .max(e1.length_squared())
+        .max((tri[2] - tri[1]).length_squared());
+    !area2.is_finite() || area2 <= 1e-14 * scale
+}
+
+/// Marks (sets to 1) every voxel that one of the triangles touches. Triangles are given in world
+/// coordinates; the test runs in grid coordinates with the box inflated by 1e-9 voxel so that a
+/// triangle lying exactly on a voxel face marks both neighbours.
+pub(crate) fn mark_surface_voxels(grid: &Grid, triangles: &[[DVec3; 3]]) -> Vec<u8> {
+    let mut marked = vec![0u8; grid.len()];
+    let half = DVec3::splat(0.5 + 1e-9);
+    for tri in triangles {
+        let g = [
+            grid.to_grid(tri[0]),
+            grid.to_grid(tri[1]),
+            grid.to_grid(tri[2]),
+        ];
+        let lo = g[0].min(g[1]).min(g[2]);
+        let hi = g[0].max(g[1]).max(g[2]);
+        let mut range = [(0usize, 0usize); 3];
+        for a in 0..3 {
+            let l = (lo[a] - 1e-6).floor().max(0.0) as usize;
+            let h = ((hi[a] + 1e-6).floor() as usize).min(grid.dims[a] - 1);
+            range[a] = (l, h);
+        }
+        for k in range[2].0..=range[2].1 {
+            for j in range[1].0..=range[1].1 {
+                for i in range[0].0..=range[0].1 {
+                    let center = DVec3::new(i as f64 + 0.5, j as f64 + 0.5, k as f64 + 0.5);
+                    if triangle_box_overlap(center, half, g) {
+                        marked[grid.index(i, j, k)] = 1;
+                    }
+                }
+            }
+        }
+    }
+    marked
+}
+
+/// Dilates a 0/1 voxel set by one voxel in all 26 directions (a 3×3×3 box), done as three
+/// separable one-voxel passes along x, y and z.
+pub(crate) fn dilate_box(grid: &Grid, set: &[u8]) -> Vec<u8> {
+    let mut current = set.to_vec();
+    let strides = [1, grid.dims[0], grid.dims[0] * grid.dims[1]];
+    for a in 0..3 {
+        let mut next = current.clone();
+        for idx in 0..grid.len() {
+            if current[idx] == 0 {
+                continue;
+            }
+            let c = grid.coords(idx);
+            if c[a] > 0 {
+                next[idx - strides[a]] = 1;
+            }
+            if c[a] + 1 < grid.dims[a] {
+                next[idx + strides[a]] = 1;
+            }
+        }
+        current = next;
+    }
+    current
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn triangle_inside_box_overlaps_and_far_triangle_does_not() {
+        let tri = [DVec3::ZERO, DVec3::X * 0.1, DVec3::Y * 0.1];
+        assert!(triangle_box_overlap(DVec3::ZERO, DVec3::splat(0.5), tri));
+        let far = tri.map(|p| p + DVec3::splat(3.0));
+        assert!(!triangle_box_overlap(DVec3::ZERO, DVec3::splat(0.5), far));
+    }
+
+    #[test]
+    fn diagonal_triangle_missing_the_corner_is_separated_by_its_plane() {
+        // Plane x + y + z = 2.9 passes near the box corner (0.5, 0.5, 0.5) only at distance.
+        let tri = [
+            DVec3::new(2.9, 0.0, 0.0),
+            DVec3::new(0.0, 2.9, 0.0),
+            DVec3::new(0.0, 0.0, 2.9),
+        ];
+        assert!(!triangle_box_overlap(DVec3::ZERO, DVec3::splat(0.5), tri));
+        let closer = tri.map(|p| p * (1.4 / 2.9));
+        assert!(triangle_box_overlap(DVec3::ZERO, DVec3::splat(0.5), closer));
+    }
+
+    #[test]
+    fn triangle_plane_passing_beside_a_box_edge_separates() {
+        // A long thin triangle along the direction (1, -1, 0), just beyond the box edge at
+        // x = y = 0.5: its plane separates it.
+        let tri = [
+            DVec3::new(3.0, -1.9, -5.0),
+            DVec3::new(-1.9, 3.0, -5.0),
+            DVec3::new(-1.9, 3.0, 5.0),
+        ];
+        assert!(!triangle_box_overlap(DVec3::ZERO, DVec3::splat(0.5), tri));
+    }
+
+    #[test]
+    fn dilation_grows_a_single_voxel_into_a_3x3x3_block() {
+        let grid = Grid {
+            dims: [5, 5, 5],
+            origin: DVec3::ZERO,
+            voxel_size: 1.0,
+        };
+        let mut set = vec![0u8; grid.len()];
+        set[grid.index(2, 2, 2)] = 1;
+        let d = dilate_box(&grid, &set);
+        assert_eq!(d.iter().filter(|&&x| x == 1).count(), 27);
+        assert_eq!(d[grid.index(1, 1, 1)], 1);
+        assert_eq!(d[grid.index(0, 2, 2)], 0);
+    }
+}
