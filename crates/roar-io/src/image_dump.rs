@@ -23,7 +23,7 @@ fn check_size(path: &Path, width: u32, height: u32, len: usize, unit: &str) -> R
 /// Writes an 8-bit RGBA PNG. `data` is row-major from the top row, 4 bytes per pixel, so
 /// `data.len() == 4 · width · height` (else an error, nothing written).
 pub fn write_png_rgba8(path: &Path, width: u32, height: u32, data: &[u8]) -> Result<(), IoError> {
-    if data.len() % 4 != 0 {
+    if !data.len().is_multiple_of(4) {
         return Err(IoError::InvalidInput {
             path: path.to_path_buf(),
             message: format!("RGBA8 buffer length {} is not a multiple of 4", data.len()),

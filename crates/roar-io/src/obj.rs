@@ -203,7 +203,7 @@ f 1/1/1 2/1/1 3/1/1 4/1/1\r\nf -4//1 -2//1 -1//1\r\nl 1 2\r\n";
         let soup = TriangleSoup::new(
             vec![
                 DVec3::new(0.1, -1e-300, 1e300),
-                DVec3::new(std::f64::consts::PI, -0.0, 123456789.123456789),
+                DVec3::new(std::f64::consts::PI, -0.0, 123_456_789.123_456_78),
                 DVec3::new(f64::MIN_POSITIVE, f64::MAX, -f64::EPSILON),
             ],
             vec![[0, 1, 2], [2, 1, 0]],
