@@ -429,7 +429,14 @@ fn read_body(
         } else {
             (Role::Skip, "element")
         };
-        for index in 0..element.count {
+        // An element without properties occupies no bytes: walking a huge count of them
+        // would only burn time.
+        let count = if element.properties.is_empty() {
+            0
+        } else {
+            element.count
+        };
+        for index in 0..count {
             let fail = |src: &dyn Source, msg: String| {
                 let location = src.location(kind, index);
                 let message = match location {
