@@ -73,10 +73,14 @@ pub fn detect(bytes: &[u8]) -> Option<StlEncoding> {
             return Some(StlEncoding::Binary);
         }
     }
+    // ASCII STL is text: a NUL byte means a binary file (truncated, or with a wrong count),
+    // even if its header starts with "solid".
     let start = bytes.iter().position(|b| !b.is_ascii_whitespace())?;
-    bytes[start..]
-        .starts_with(b"solid")
-        .then_some(StlEncoding::Ascii)
+    let starts_with_solid = bytes[start..]
+        .get(..5)
+        .is_some_and(|w| w.eq_ignore_ascii_case(b"solid"));
+    let has_nul = bytes[..bytes.len().min(4096)].contains(&0);
+    (starts_with_solid && !has_nul).then_some(StlEncoding::Ascii)
 }
 
 fn binary_count(bytes: &[u8]) -> u32 {
@@ -148,6 +152,8 @@ fn read_ascii(bytes: &[u8], file: &str) -> Result<TriangleSoup, IoError> {
         last_line = line_no;
         let mut toks = tokens(raw);
         let Some(keyword) = toks.next() else { continue };
+        // Keywords are lower case by the format, but some exporters shout.
+        let lower = keyword.to_ascii_lowercase();
         let unexpected = |state: State| {
             IoError::at_line(
                 file,
@@ -155,7 +161,7 @@ fn read_ascii(bytes: &[u8], file: &str) -> Result<TriangleSoup, IoError> {
                 format!("unexpected {:?} (in state {state:?})", show(keyword)),
             )
         };
-        state = match (state, keyword) {
+        state = match (state, lower.as_slice()) {
             // The solid's name (rest of the line) is free text.
             (State::Outside, b"solid") => State::Solid,
             (State::Solid, b"endsolid") => State::Outside,
@@ -286,6 +292,29 @@ mod tests {
         assert_eq!(soup.positions.len(), 7);
         assert_eq!(soup.triangles, vec![[0, 1, 2], [3, 4, 5], [3, 5, 6]]);
         assert_eq!(soup.n_polygons, 1);
+    }
+
+    #[test]
+    fn upper_case_keywords_are_accepted() {
+        let text = String::from_utf8_lossy(TWO_SOLIDS).to_uppercase();
+        assert_eq!(
+            read_stl(text.as_bytes(), "t.stl").unwrap().triangles.len(),
+            3
+        );
+    }
+
+    #[test]
+    fn truncated_binary_starting_with_solid_is_reported_as_binary() {
+        let soup = TriangleSoup::new(vec![DVec3::ZERO, DVec3::X, DVec3::Y], vec![[0, 1, 2]; 2]);
+        let mut bytes = Vec::new();
+        write_stl(&mut bytes, &soup, StlEncoding::Binary).unwrap();
+        bytes[..5].copy_from_slice(b"solid");
+        bytes.pop();
+        let e = read_stl(&bytes, "t.stl").unwrap_err().to_string();
+        assert!(
+            e.contains("header says 2 triangles (184 bytes) but the file has 183"),
+            "{e}"
+        );
     }
 
     #[test]
