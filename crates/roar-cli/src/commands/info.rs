@@ -33,7 +33,7 @@ pub struct Info {
     pub closed_manifold: bool,
     /// Genus (summed over components), if a closed manifold.
     #[serde(skip_serializing_if = "Option::is_none")]
-    pub genus: Option<i64>,
+    pub genus: Option<usize>,
     /// Connected components, if a closed manifold.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub components: Option<usize>,

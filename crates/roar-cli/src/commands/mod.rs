@@ -1,5 +1,7 @@
 //! One module per `roar` subcommand: a clap `Args` struct and a `run` function returning
 //! `anyhow::Result<()>`, so the binary only dispatches and prints errors.
 
+pub mod eval;
 pub mod example;
 pub mod info;
+pub mod render;
