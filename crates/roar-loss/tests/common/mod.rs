@@ -125,7 +125,7 @@ pub fn read_mesh(path: &std::path::Path) -> (Vec<DVec3>, Vec<[u32; 3]>) {
     let text = std::fs::read_to_string(path).unwrap();
     let mut p = Vec::new();
     let mut t = Vec::new();
-    let mut fan = |poly: &[u32], t: &mut Vec<[u32; 3]>| {
+    let fan = |poly: &[u32], t: &mut Vec<[u32; 3]>| {
         for k in 1..poly.len().saturating_sub(1) {
             t.push([poly[0], poly[k], poly[k + 1]]);
         }
