@@ -27,7 +27,8 @@ pub struct RenderLoss {
 
 impl RenderLoss {
     /// The paper's render loss against a target: its cameras and renders, source culling off,
-    /// antialiasing on, L1.
+    /// antialiasing on, L1. Clones the renders (36 × 512² × 16 B ≈ 151 MB at the defaults);
+    /// to avoid the copy, build the struct directly with `std::mem::take(&mut target.renders)`.
     pub fn new(target: &Target) -> Self {
         Self {
             cameras: target.cameras.clone(),

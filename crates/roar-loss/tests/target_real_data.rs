@@ -20,17 +20,19 @@ fn wild_soups_give_clean_targets_and_point_clouds() {
         "trimesh-rabbit.obj",
     ] {
         let (positions, triangles) = common::read_mesh(&dir.join(name));
-        let start = Instant::now();
+        let (start, cpu) = (Instant::now(), common::cpu_seconds());
         let target = build_target(&positions, &triangles, &TargetOptions::default()).unwrap();
         let build_time = start.elapsed();
-        let start = Instant::now();
+        let build_cpu = common::cpu_seconds() - cpu;
+        let (start, cpu) = (Instant::now(), common::cpu_seconds());
         let cloud = point_cloud(&target, &PointCloudOptions::default()).unwrap();
         let cloud_time = start.elapsed();
+        let cloud_cpu = common::cpu_seconds() - cpu;
         let s = target.stats;
         println!(
             "{name}: {} v / {} f in; welded {}, degenerate {}, duplicates {}, twins dropped {}, \
              undecided {}, tied {} (unseen {}), unreferenced {}; T' {} v / {} f; \
-             build_target {:.2} s; P {} of 200k in {:.2} s",
+             build_target {:.2} s ({:.2} s CPU); P {} of 200k in {:.2} s ({:.2} s CPU)",
             s.input_vertices,
             s.input_faces,
             s.welded_vertices,
@@ -44,8 +46,10 @@ fn wild_soups_give_clean_targets_and_point_clouds() {
             s.output_vertices,
             s.output_faces,
             build_time.as_secs_f64(),
+            build_cpu,
             cloud.len(),
             cloud_time.as_secs_f64(),
+            cloud_cpu,
         );
         let pairs = s.twins_dropped + s.pairs_undecided + s.pairs_tied;
         assert_eq!(
