@@ -2,3 +2,29 @@
 //! once here and used by every crate: triangle BVH, closest point, ray cast, exact
 //! triangle–triangle test, fast winding number, regular face sampling, the `Projector` trait and
 //! the `Normalization` into the camera rig's sphere.
+//!
+//! Conventions shared by every submodule (libigl style): `positions` is #V points, `triangles`
+//! is #F index triples into `positions`, a *face* is an index into `triangles`, barycentric
+//! coordinates `[w0, w1, w2]` weight a face's corners in order. Functions never panic on bad
+//! indices: faces that reference a missing vertex are ignored (each function says how).
+//!
+//! Modules: [`aabb`] (boxes), [`normalization`] (into the rig sphere and back),
+//! [`point_triangle`] (one-triangle closest point and ray hit), [`bvh`] (the triangle tree),
+//! [`tri_tri`] (exact triangle–triangle tests), [`self_intersections`], [`sampling`]
+//! (area-weighted random samples).
+
+pub mod aabb;
+pub mod bvh;
+pub mod normalization;
+pub mod point_triangle;
+pub mod sampling;
+pub mod self_intersections;
+pub mod tri_tri;
+
+pub use aabb::Aabb;
+pub use bvh::{ClosestPoint, RayHit, TriangleBvh};
+pub use normalization::{Normalization, RIG_RADIUS};
+pub use point_triangle::{closest_point_on_triangle, ray_triangle};
+pub use sampling::{SurfaceSamples, sample_surface};
+pub use self_intersections::{face_intersects_any, intersecting_pairs, self_intersecting_faces};
+pub use tri_tri::{faces_intersect, segment_intersects_triangle, triangles_intersect};
