@@ -5,3 +5,4 @@
 //! initial meshes (watertight init from soups, icosphere, SDF voxel init).
 
 pub mod optim;
+pub mod qem;
