@@ -6,3 +6,4 @@
 
 pub mod optim;
 pub mod qem;
+pub mod untangle;
