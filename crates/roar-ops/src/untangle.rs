@@ -514,11 +514,16 @@ pub fn limit_steps(
                 b.max += DVec3::splat(grow);
                 candidates.clear();
                 bvh.faces_in_aabb(&b, |g| candidates.push(g));
+                let exact = Aabb::from_triangle(tf.map(|i| current[i as usize]));
                 for &g in &candidates {
                     let Some(&tg) = triangles.get(g as usize) else {
                         continue;
                     };
                     if g == f || !valid(&tg) {
+                        continue;
+                    }
+                    // Cheap reject with the current corners before the exact test.
+                    if !Aabb::from_triangle(tg.map(|i| current[i as usize])).overlaps(&exact) {
                         continue;
                     }
                     stats.pair_tests += 1;

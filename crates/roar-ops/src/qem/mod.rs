@@ -631,3 +631,32 @@ impl<'m, F: FnMut(&Collapse)> Decimator<'m, F> {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn quality_is_one_for_equilateral_and_grows_for_slivers() {
+        let eq = [
+            DVec3::ZERO,
+            DVec3::X,
+            DVec3::new(0.5, 3f64.sqrt() / 2.0, 0.0),
+        ];
+        assert!((triangle_quality(eq) - 1.0).abs() < 1e-12);
+        let sliver = [DVec3::ZERO, DVec3::X, DVec3::new(0.5, 0.01, 0.0)];
+        assert!(triangle_quality(sliver) > 20.0);
+        assert_eq!(
+            triangle_quality([DVec3::ZERO, DVec3::X, 2.0 * DVec3::X]),
+            f64::INFINITY
+        );
+    }
+
+    #[test]
+    fn minimum_faces_follow_heawood() {
+        assert_eq!(minimum_faces_for_genus(0), 4);
+        assert_eq!(minimum_faces_for_genus(1), 14); // Császár torus, 7 vertices
+        assert_eq!(minimum_faces_for_genus(2), 24); // 10 vertices
+        assert_eq!(minimum_faces_for_genus(3), 24); // 10 vertices (Heawood)
+    }
+}
