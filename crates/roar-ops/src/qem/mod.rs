@@ -657,6 +657,6 @@ mod tests {
         assert_eq!(minimum_faces_for_genus(0), 4);
         assert_eq!(minimum_faces_for_genus(1), 14); // Császár torus, 7 vertices
         assert_eq!(minimum_faces_for_genus(2), 24); // 10 vertices
-        assert_eq!(minimum_faces_for_genus(3), 24); // 10 vertices (Heawood)
+        assert_eq!(minimum_faces_for_genus(3), 28); // 10 vertices (Heawood)
     }
 }
