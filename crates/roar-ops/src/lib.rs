@@ -6,3 +6,5 @@
 
 pub mod init;
 pub mod optim;
+pub mod qem;
+pub mod untangle;
