@@ -179,6 +179,9 @@ fn grid_score(
         }
         subs.push(Some(n));
     }
+    for n in normals.iter_mut() {
+        *n = n.normalize_or_zero();
+    }
     let mut score = 0.0;
     for (t, n) in samples.face_sub_triangles(f).zip(subs.iter()) {
         let Some(n) = *n else { continue };
@@ -189,7 +192,7 @@ fn grid_score(
         let fold = 1.0
             - idx
                 .iter()
-                .map(|&i| n.dot(normals[i as usize - start].normalize_or_zero()))
+                .map(|&i| n.dot(normals[i as usize - start]))
                 .sum::<f64>()
                 / 3.0;
         if fold > 1.0 || fold < sub_threshold {
