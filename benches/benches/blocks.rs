@@ -2,7 +2,7 @@
 //! Face Split under and at budget against the analytic sphere projector (O(1) per sample, so
 //! the figure is the block's own cost), tangential smoothing. Goal: < 20 ms per block call.
 
-use criterion::{BatchSize, Criterion, criterion_group, criterion_main};
+use criterion::{BatchSize, Criterion, criterion_main};
 use roar_mesh::shapes::perturbed;
 use roar_mesh::spatial::SphereProjector;
 use roar_mesh::{DVec3, Mesh};
