@@ -299,7 +299,7 @@ pub fn t2s_moves(
         };
         let (t, m) = (target_points[*j], target_normals[*j]);
         let cos = m.dot(n);
-        if !(cos >= normal_dot) || cos <= 0.0 {
+        if cos.is_nan() || cos < normal_dot || cos <= 0.0 {
             continue;
         }
         let d = ((t - samples[i]).dot(m) / cos) * n;
