@@ -5,6 +5,12 @@
 //! §3.1–§3.4), behind the common [`Loss`] trait so a researcher can add or swap a term without
 //! touching the pipeline.
 
+pub mod knn_projector;
+pub mod planar;
+
+pub use knn_projector::{KnnOptions, KnnPlanarProjector, PlanarMode};
+pub use planar::{PlanarLoss, PlanarOptions, PlanarStats};
+
 use glam::DVec3;
 
 pub mod point_cloud;

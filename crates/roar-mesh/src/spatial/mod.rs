@@ -13,13 +13,14 @@
 //! [`tri_tri`] (exact triangle–triangle tests), [`self_intersections`], [`sampling`]
 //! (area-weighted random samples),
 //! [`winding`] (fast winding numbers), [`regular_sampling`] (regular per-face grids),
-//! [`projector`] (the `Projector` trait).
+//! [`projector`] (the `Projector` trait), [`ray_projector`] (exact ray-cast projection, §3.4 (B)).
 
 pub mod aabb;
 pub mod bvh;
 pub mod normalization;
 pub mod point_triangle;
 pub mod projector;
+pub mod ray_projector;
 pub mod regular_sampling;
 pub mod sampling;
 pub mod self_intersections;
@@ -31,6 +32,7 @@ pub use bvh::{ClosestPoint, RayHit, TriangleBvh};
 pub use normalization::{Normalization, RIG_RADIUS};
 pub use point_triangle::{closest_point_on_triangle, ray_triangle};
 pub use projector::{Projector, SphereProjector};
+pub use ray_projector::{RayCastProjector, RayProjectorOptions};
 pub use regular_sampling::{
     RegularSamples, RegularSamplingError, RegularSamplingOptions, face_grid, regular_samples,
 };

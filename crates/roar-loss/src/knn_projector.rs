@@ -1,0 +1,325 @@
+//! k-NN planar projection of source samples onto an oriented target point cloud (spec §3.4 (A)
+//! and the source→target term of §3.2.2).
+//!
+//! Each sample `s` with unit normal `n` looks up its `k` nearest target points `t_j` (normals
+//! `m_j`), intersects the line `s + α n` with each neighbour's tangent plane, keeps the valid
+//! intersections and blends them with inverse-squared-distance weights. The kd-tree is built
+//! once over the target; queries run in parallel over fixed chunks and each answer depends only
+//! on its own sample, so results are bit-identical whatever the thread count.
+
+use glam::DVec3;
+use kiddo::SquaredEuclidean;
+use kiddo::immutable::float::kdtree::ImmutableKdTree;
+use rayon::prelude::*;
+use roar_mesh::spatial::Projector;
+use std::num::NonZero;
+
+use crate::LossError;
+
+/// Samples per parallel work item (coarse: the machine has few cores).
+const CHUNK: usize = 2048;
+
+/// Added to squared distances before inverting them into weights (spec §3.2.2 step 3).
+const WEIGHT_EPSILON: f64 = 1e-5;
+
+/// kd-tree over target points: f64 coordinates, `u32` items, bucket size 32.
+pub(crate) type PointTree = ImmutableKdTree<f64, u32, 3, 32>;
+
+/// How a sample's move is built from its valid neighbours (spec OQ-3 switches).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum PlanarMode {
+    /// Along the sample normal onto each neighbour's plane, inverse-squared-distance blend
+    /// (spec §3.2.2 s2t, the default).
+    #[default]
+    AlongNormal,
+    /// Orthogonally onto each neighbour's plane, `((t_j − s)·m_j) m_j`, same validity and
+    /// weights. The move is then not along `n` (breaks the [`Projector`] line contract; for
+    /// ablations of the loss only).
+    Orthogonal,
+    /// Along the sample normal, but only the valid neighbour with the smallest |move|
+    /// (spec §3.2.2 "alternative mode").
+    Nearest,
+}
+
+/// Options of the k-NN planar projection (spec §3.2.2 s2t, §3.4 (A)).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct KnnOptions {
+    /// Number of nearest target points per sample. Default 10 (spec §3.2.2, [SUP]).
+    pub k: usize,
+    /// A neighbour is valid only if `n·m_j >` this. Default 0.01 (the cfg value of
+    /// `normal_dot_prod_threshold`, spec §3.2.2 step 2).
+    pub normal_dot_threshold: f64,
+    /// Blow-up guard: the projected point must satisfy `|t_j − q| < guard·|t_j − s|`.
+    /// Default 1.01 (spec §3.2.2 step 2).
+    pub blowup_guard: f64,
+    /// How valid neighbours are combined. Default [`PlanarMode::AlongNormal`].
+    pub mode: PlanarMode,
+}
+
+impl Default for KnnOptions {
+    fn default() -> Self {
+        Self {
+            k: 10,
+            normal_dot_threshold: 0.01,
+            blowup_guard: 1.01,
+            mode: PlanarMode::AlongNormal,
+        }
+    }
+}
+
+/// Checks an oriented point cloud: same lengths, at least one point, finite coordinates.
+pub(crate) fn check_cloud(points: &[DVec3], normals: &[DVec3]) -> Result<(), LossError> {
+    if points.len() != normals.len() {
+        return Err(LossError::InvalidTarget(format!(
+            "{} points but {} normals",
+            points.len(),
+            normals.len()
+        )));
+    }
+    if points.is_empty() {
+        return Err(LossError::InvalidTarget("the point cloud is empty".into()));
+    }
+    if points.len() > u32::MAX as usize {
+        return Err(LossError::InvalidTarget("more than 2^32 points".into()));
+    }
+    if let Some(i) = points
+        .iter()
+        .zip(normals)
+        .position(|(p, n)| !p.is_finite() || !n.is_finite())
+    {
+        return Err(LossError::InvalidTarget(format!(
+            "point {i} or its normal is not finite"
+        )));
+    }
+    Ok(())
+}
+
+/// Builds the kd-tree over `points` (assumed checked by [`check_cloud`] or non-empty finite).
+pub(crate) fn build_tree(points: &[DVec3]) -> PointTree {
+    let coords: Vec<[f64; 3]> = points.iter().map(|p| p.to_array()).collect();
+    ImmutableKdTree::new_from_slice(&coords)
+}
+
+/// k-NN planar projector over a fixed oriented target point cloud (spec §3.4 (A)).
+#[derive(Debug, Clone)]
+pub struct KnnPlanarProjector {
+    tree: PointTree,
+    points: Vec<DVec3>,
+    /// Unit normals (zero where the input normal was zero: such points are never valid).
+    normals: Vec<DVec3>,
+    options: KnnOptions,
+}
+
+impl KnnPlanarProjector {
+    /// Builds the kd-tree over the target points `points` with normals `normals` (one per point,
+    /// normalized here). Errors: mismatched lengths, empty cloud, non-finite input.
+    pub fn new(
+        points: &[DVec3],
+        normals: &[DVec3],
+        options: &KnnOptions,
+    ) -> Result<Self, LossError> {
+        check_cloud(points, normals)?;
+        Ok(Self {
+            tree: build_tree(points),
+            points: points.to_vec(),
+            normals: normals.iter().map(|n| n.normalize_or_zero()).collect(),
+            options: *options,
+        })
+    }
+
+    /// The options the projector was built with.
+    pub fn options(&self) -> &KnnOptions {
+        &self.options
+    }
+
+    /// The target points.
+    pub fn points(&self) -> &[DVec3] {
+        &self.points
+    }
+
+    /// The target unit normals.
+    pub fn normals(&self) -> &[DVec3] {
+        &self.normals
+    }
+
+    /// The `k` nearest target points of `p` as `(index, squared distance)`, sorted by distance
+    /// then index (distances recomputed in f64, so the order is exact). Fewer when the cloud is
+    /// smaller than `k`; empty for `k = 0` or a non-finite `p`.
+    pub fn nearest(&self, p: DVec3, k: usize) -> Vec<(u32, f64)> {
+        let Some(k) = NonZero::new(k.min(self.points.len())) else {
+            return Vec::new();
+        };
+        if !p.is_finite() {
+            return Vec::new();
+        }
+        let mut found: Vec<(u32, f64)> = self
+            .tree
+            .nearest_n::<SquaredEuclidean>(&p.to_array(), k)
+            .into_iter()
+            .map(|nn| (nn.item, self.points[nn.item as usize].distance_squared(p)))
+            .collect();
+        found.sort_by(|a, b| a.1.total_cmp(&b.1).then(a.0.cmp(&b.0)));
+        found
+    }
+
+    /// The move `d` of sample `s` with unit normal `n` (spec §3.2.2 s2t steps 1–3): `None` when
+    /// no neighbour is valid or the input is not finite.
+    pub fn displacement(&self, s: DVec3, n: DVec3) -> Option<DVec3> {
+        if !s.is_finite() || !n.is_finite() {
+            return None;
+        }
+        let neighbours = self.nearest(s, self.options.k);
+        planar_move(
+            s,
+            n,
+            neighbours
+                .iter()
+                .map(|&(j, d2)| (self.points[j as usize], self.normals[j as usize], d2)),
+            &self.options,
+        )
+    }
+
+    /// [`KnnPlanarProjector::displacement`] of every sample, in parallel over fixed chunks
+    /// (deterministic). A missing normal (`normals` shorter than `points`) gives `None`.
+    pub fn displacements(&self, points: &[DVec3], normals: &[DVec3]) -> Vec<Option<DVec3>> {
+        let work = |start: usize, chunk: &[DVec3]| -> Vec<Option<DVec3>> {
+            chunk
+                .iter()
+                .enumerate()
+                .map(|(i, &s)| {
+                    normals
+                        .get(start + i)
+                        .and_then(|&n| self.displacement(s, n))
+                })
+                .collect()
+        };
+        if points.len() <= CHUNK {
+            return work(0, points);
+        }
+        points
+            .par_chunks(CHUNK)
+            .enumerate()
+            .map(|(c, chunk)| work(c * CHUNK, chunk))
+            .collect::<Vec<_>>()
+            .concat()
+    }
+}
+
+impl Projector for KnnPlanarProjector {
+    fn project(
+        &self,
+        _positions: &[DVec3],
+        _triangles: &[[u32; 3]],
+        points: &[DVec3],
+        normals: &[DVec3],
+    ) -> Vec<Option<DVec3>> {
+        self.displacements(points, normals)
+            .into_iter()
+            .zip(points)
+            .map(|(d, &s)| d.map(|d| s + d))
+            .collect()
+    }
+}
+
+/// The planar move of sample `s` (unit normal `n`) from its neighbours `(t_j, m_j, d_j²)`
+/// (spec §3.2.2 s2t steps 2–3; `mode` picks the OQ-3 variant). `None` when no neighbour is
+/// valid. Neighbour validity: `n·m_j > threshold` and the blow-up guard on the along-normal
+/// projection (also used to validate the orthogonal variant).
+pub fn planar_move(
+    s: DVec3,
+    n: DVec3,
+    neighbours: impl IntoIterator<Item = (DVec3, DVec3, f64)>,
+    options: &KnnOptions,
+) -> Option<DVec3> {
+    let mut weight_sum = 0.0;
+    let mut weighted = DVec3::ZERO;
+    let mut nearest: Option<DVec3> = None;
+    for (t, m, d2) in neighbours {
+        let cos = n.dot(m);
+        if cos.is_nan() || cos <= options.normal_dot_threshold {
+            continue;
+        }
+        let alpha = (t - s).dot(m) / cos;
+        let along = alpha * n;
+        let guard = (t - (s + along)).length() < options.blowup_guard * (t - s).length();
+        if !guard || !along.is_finite() {
+            continue;
+        }
+        let w = 1.0 / (d2 + WEIGHT_EPSILON);
+        match options.mode {
+            PlanarMode::AlongNormal => {
+                weighted += w * along;
+                weight_sum += w;
+            }
+            PlanarMode::Orthogonal => {
+                weighted += w * (t - s).dot(m) * m;
+                weight_sum += w;
+            }
+            PlanarMode::Nearest => {
+                if nearest.is_none_or(|best| along.length_squared() < best.length_squared()) {
+                    nearest = Some(along);
+                }
+            }
+        }
+    }
+    match options.mode {
+        PlanarMode::Nearest => nearest,
+        _ if weight_sum > 0.0 => Some(weighted / weight_sum),
+        _ => None,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn flat_plane_moves_sample_onto_it_along_normal() {
+        // Target: the plane z = 0 with normal +z; sample above it, tilted normal.
+        let mut points = Vec::new();
+        for i in -5..=5 {
+            for j in -5..=5 {
+                points.push(DVec3::new(i as f64 * 0.1, j as f64 * 0.1, 0.0));
+            }
+        }
+        let normals = vec![DVec3::Z; points.len()];
+        let proj = KnnPlanarProjector::new(&points, &normals, &KnnOptions::default()).unwrap();
+        let s = DVec3::new(0.03, -0.02, 0.2);
+        let n = DVec3::new(0.2, 0.1, 1.0).normalize();
+        let d = proj.displacement(s, n).unwrap();
+        assert!((s + d).z.abs() < 1e-12);
+        assert!(d.cross(n).length() < 1e-12);
+    }
+
+    #[test]
+    fn opposite_normals_are_invalid() {
+        let points = vec![DVec3::ZERO, DVec3::X * 0.1];
+        let normals = vec![-DVec3::Z, -DVec3::Z];
+        let proj = KnnPlanarProjector::new(&points, &normals, &KnnOptions::default()).unwrap();
+        assert_eq!(proj.displacement(DVec3::Z * 0.1, DVec3::Z), None);
+        assert_eq!(proj.displacement(DVec3::splat(f64::NAN), DVec3::Z), None);
+    }
+
+    #[test]
+    fn bad_clouds_are_errors() {
+        let o = KnnOptions::default();
+        assert!(KnnPlanarProjector::new(&[], &[], &o).is_err());
+        assert!(KnnPlanarProjector::new(&[DVec3::ZERO], &[], &o).is_err());
+        assert!(KnnPlanarProjector::new(&[DVec3::splat(f64::NAN)], &[DVec3::Z], &o).is_err());
+    }
+
+    #[test]
+    fn nearest_mode_picks_smallest_move() {
+        let o = KnnOptions {
+            mode: PlanarMode::Nearest,
+            ..KnnOptions::default()
+        };
+        let s = DVec3::ZERO;
+        let neighbours = [
+            (DVec3::new(0.0, 0.0, 0.3), DVec3::Z, 0.09),
+            (DVec3::new(0.0, 0.0, 0.1), DVec3::Z, 0.01),
+        ];
+        let d = planar_move(s, DVec3::Z, neighbours, &o).unwrap();
+        assert!((d - DVec3::Z * 0.1).length() < 1e-15);
+    }
+}

@@ -1,0 +1,477 @@
+//! The planar projection loss `L_planar` (spec §3.2.2, OQ-3, Verification note 2).
+//!
+//! Every evaluation regularly samples the current source mesh (spec §3.3, sample normals blended
+//! from ROAR vertex normals), moves each sample toward the target point cloud P along its normal
+//! (k-NN planar projection, the s2t term, plus the t2s term that reaches thin target parts), and
+//! measures `scale · mean_i ‖s_i − sg(s_i + d_i)‖²`. The projected points are constants
+//! (stop-gradient), so `∂L/∂s_i = −2·scale·d_i / N` and each sample passes its gradient to its
+//! face's three vertices through its barycentric weights.
+
+use glam::DVec3;
+use kiddo::SquaredEuclidean;
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use rayon::prelude::*;
+use roar_mesh::spatial::{RegularSamples, RegularSamplingOptions, regular_samples};
+
+use crate::knn_projector::{KnnOptions, KnnPlanarProjector, build_tree};
+use crate::{Loss, LossError};
+
+/// Target points per parallel work item of the t2s assignment.
+const CHUNK: usize = 4096;
+
+/// Default of [`PlanarOptions::scale`] (Verification note 2). Measured by
+/// `examples/planar_balance.rs` (36 views at 256², L1 render loss, icosphere source of radius 0.5
+/// against a sphere of radius R, P = 200k exact samples): mean per-vertex gradient norm of the
+/// render loss over the raw planar loss is 15–20 at R − r = 0.01 and 2.8–3.8 at R − r = 0.05
+/// (icospheres of 320, 1280 and 5120 faces; the ratio does not drift with resolution because both
+/// scale like 1/#V). A factor 5 brings the terms to 3–4× (gap 0.01) and 0.6–0.8× (gap 0.05) at
+/// weight 1, i.e. within 10× over the working range; the planar term still fades as the gap
+/// closes (it is quadratic), the render term does not.
+pub const DEFAULT_PLANAR_SCALE: f64 = 5.0;
+
+/// Options of [`PlanarLoss`] (spec §3.2.2, §3.3, OQ-3).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PlanarOptions {
+    /// The s2t k-NN projection (k = 10, threshold 0.01, guard 1.01, mode along-normal; OQ-3).
+    pub knn: KnnOptions,
+    /// Include the target→source term (spec §3.2.2 t2s; default true, OQ-3 "no-t2s" switch).
+    pub t2s: bool,
+    /// t2s moves a sample only if `m_{t*}·n_i ≥` this. Default 0.95 (spec §3.2.2 t2s step 3).
+    pub t2s_normal_dot: f64,
+    /// Regular sampling of the source (spec §3.3: δ = 0.002, n ≤ 16, n ≥ 3).
+    pub sampling: RegularSamplingOptions,
+    /// Cap on source samples per evaluation (default 100 000). Above it, every face keeps a
+    /// share `cap/total` of its samples (stratified, see [`stratified_subsample`]).
+    pub max_samples: usize,
+    /// Multiplies the raw loss `mean_i ‖d_i‖²` and its gradient (Verification note 2).
+    /// 1 is the raw spec loss; the default [`DEFAULT_PLANAR_SCALE`] makes the planar gradient
+    /// comparable to the render gradient at weight 1. The raw and render gradients both scale
+    /// like 1/#V per vertex, so a constant factor keeps the balance across resolutions.
+    pub scale: f64,
+    /// Seed of the ChaCha8 stream that drives sampling; advanced on every evaluation.
+    pub seed: u64,
+}
+
+impl Default for PlanarOptions {
+    fn default() -> Self {
+        Self {
+            knn: KnnOptions::default(),
+            t2s: true,
+            t2s_normal_dot: 0.95,
+            sampling: RegularSamplingOptions::default(),
+            max_samples: 100_000,
+            scale: DEFAULT_PLANAR_SCALE,
+            seed: 0,
+        }
+    }
+}
+
+impl PlanarOptions {
+    /// The spec's raw loss (`scale = 1`, mean over samples), other options default.
+    pub fn raw() -> Self {
+        Self {
+            scale: 1.0,
+            ..Self::default()
+        }
+    }
+}
+
+/// What the last evaluation of [`PlanarLoss`] did.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct PlanarStats {
+    /// Regular samples generated on the source.
+    pub samples_generated: usize,
+    /// Samples kept after the cap (the N of the mean).
+    pub samples_used: usize,
+    /// Kept samples with no valid move from either term (d = 0).
+    pub unprojected: usize,
+    /// Kept samples whose move came from the t2s term (larger magnitude than s2t).
+    pub from_t2s: usize,
+    /// Raw loss `mean ‖d_i‖²` (before `scale`).
+    pub raw_loss: f64,
+    /// Largest |d_i|.
+    pub max_move: f64,
+}
+
+/// The planar projection loss against a fixed oriented point cloud (spec §3.2.2).
+pub struct PlanarLoss {
+    projector: KnnPlanarProjector,
+    options: PlanarOptions,
+    rng: ChaCha8Rng,
+    /// Statistics of the last evaluation.
+    pub last_stats: PlanarStats,
+}
+
+impl PlanarLoss {
+    /// A planar loss toward the target cloud `points`/`normals` (one unit normal per point).
+    /// Errors: mismatched lengths, empty cloud, non-finite input.
+    pub fn new(
+        points: &[DVec3],
+        normals: &[DVec3],
+        options: &PlanarOptions,
+    ) -> Result<Self, LossError> {
+        Ok(Self {
+            projector: KnnPlanarProjector::new(points, normals, &options.knn)?,
+            options: *options,
+            rng: ChaCha8Rng::seed_from_u64(options.seed),
+            last_stats: PlanarStats::default(),
+        })
+    }
+
+    /// The options in use.
+    pub fn options(&self) -> &PlanarOptions {
+        &self.options
+    }
+
+    /// The k-NN projector over the target cloud.
+    pub fn projector(&self) -> &KnnPlanarProjector {
+        &self.projector
+    }
+
+    /// The moves `d_i` of the given samples (s2t, combined with t2s when enabled): `None` when
+    /// neither term gives a valid move. Deterministic.
+    pub fn moves(&self, points: &[DVec3], normals: &[DVec3]) -> Vec<Option<DVec3>> {
+        let s2t = self.projector.displacements(points, normals);
+        if !self.options.t2s {
+            return s2t;
+        }
+        let t2s = t2s_moves(
+            points,
+            normals,
+            self.projector.points(),
+            self.projector.normals(),
+            self.options.t2s_normal_dot,
+        );
+        combine_moves(&s2t, &t2s)
+    }
+
+    /// The regular samples of this evaluation: samples every face with vertex normals of the
+    /// source (spec §2.2), advances the RNG, then applies the cap. Returns the samples and the
+    /// indices kept.
+    fn draw_samples(
+        &mut self,
+        positions: &[DVec3],
+        triangles: &[[u32; 3]],
+    ) -> Result<(RegularSamples, Vec<usize>), LossError> {
+        let normals = vertex_normals(positions, triangles);
+        let samples = regular_samples(
+            positions,
+            triangles,
+            Some(&normals),
+            &self.options.sampling,
+            &mut self.rng,
+        )
+        .map_err(|e| LossError::InvalidMesh(e.to_string()))?;
+        let kept = stratified_subsample(&samples, self.options.max_samples, &mut self.rng);
+        Ok((samples, kept))
+    }
+}
+
+impl Loss for PlanarLoss {
+    fn name(&self) -> &'static str {
+        "planar"
+    }
+
+    fn value_and_grad(
+        &mut self,
+        positions: &[DVec3],
+        triangles: &[[u32; 3]],
+    ) -> Result<(f64, Vec<DVec3>), LossError> {
+        check_mesh(positions, triangles)?;
+        let (samples, kept) = self.draw_samples(positions, triangles)?;
+        let points: Vec<DVec3> = kept.iter().map(|&i| samples.points[i]).collect();
+        let normals: Vec<DVec3> = kept.iter().map(|&i| samples.normals[i]).collect();
+        let faces: Vec<u32> = kept.iter().map(|&i| samples.faces[i]).collect();
+        let barycentrics: Vec<[f64; 3]> = kept.iter().map(|&i| samples.barycentrics[i]).collect();
+
+        let s2t = self.projector.displacements(&points, &normals);
+        let (moves, from_t2s) = if self.options.t2s {
+            let t2s = t2s_moves(
+                &points,
+                &normals,
+                self.projector.points(),
+                self.projector.normals(),
+                self.options.t2s_normal_dot,
+            );
+            let from_t2s = s2t
+                .iter()
+                .zip(&t2s)
+                .filter(|(a, b)| len2(**b) > len2(**a))
+                .count();
+            (combine_moves(&s2t, &t2s), from_t2s)
+        } else {
+            (s2t, 0)
+        };
+        let targets: Vec<Option<DVec3>> = moves
+            .iter()
+            .zip(&points)
+            .map(|(d, &s)| d.map(|d| s + d))
+            .collect();
+        let (raw, mut grad) =
+            planar_loss_fixed_targets(positions, triangles, &faces, &barycentrics, &targets);
+        for g in &mut grad {
+            *g *= self.options.scale;
+        }
+        self.last_stats = PlanarStats {
+            samples_generated: samples.points.len(),
+            samples_used: points.len(),
+            unprojected: moves.iter().filter(|d| d.is_none()).count(),
+            from_t2s,
+            raw_loss: raw,
+            max_move: moves
+                .iter()
+                .flatten()
+                .map(|d| d.length())
+                .fold(0.0, f64::max),
+        };
+        Ok((self.options.scale * raw, grad))
+    }
+}
+
+/// Squared length of an optional move (0 for `None`).
+fn len2(d: Option<DVec3>) -> f64 {
+    d.map_or(0.0, |d| d.length_squared())
+}
+
+/// Per sample, the move with the larger magnitude of the two terms (spec §3.2.2
+/// "Combination"); ties and equal magnitudes keep s2t. `None` only when both are `None`.
+pub fn combine_moves(s2t: &[Option<DVec3>], t2s: &[Option<DVec3>]) -> Vec<Option<DVec3>> {
+    s2t.iter()
+        .enumerate()
+        .map(|(i, &a)| {
+            let b = t2s.get(i).copied().flatten();
+            match (a, b) {
+                (Some(a), Some(b)) if b.length_squared() > a.length_squared() => Some(b),
+                (None, Some(b)) => Some(b),
+                _ => a,
+            }
+        })
+        .collect()
+}
+
+/// The target→source term (spec §3.2.2 t2s): every target point is assigned to its nearest
+/// sample (kd-tree over the samples, ties to the smaller sample index via the tree's fixed
+/// order); each sample takes its farthest assigned point `t*` (ties: smaller target index) and,
+/// if `m_{t*}·n_i ≥ normal_dot`, the along-normal intersection with the plane `(t*, m_{t*})`.
+/// The blow-up guard of s2t is not applied (the 0.95 gate bounds the move). `None` for samples
+/// with no assigned point, a failed gate, or non-finite input.
+pub fn t2s_moves(
+    samples: &[DVec3],
+    sample_normals: &[DVec3],
+    target_points: &[DVec3],
+    target_normals: &[DVec3],
+    normal_dot: f64,
+) -> Vec<Option<DVec3>> {
+    let mut result = vec![None; samples.len()];
+    let finite: Vec<usize> = (0..samples.len())
+        .filter(|&i| samples[i].is_finite())
+        .collect();
+    if finite.is_empty() || target_points.is_empty() {
+        return result;
+    }
+    let finite_points: Vec<DVec3> = finite.iter().map(|&i| samples[i]).collect();
+    let tree = build_tree(&finite_points);
+    let assign = |t: &DVec3| -> Option<(u32, f64)> {
+        if !t.is_finite() {
+            return None;
+        }
+        let nn = tree.nearest_one::<SquaredEuclidean>(&t.to_array());
+        let i = finite[nn.item as usize];
+        Some((i as u32, samples[i].distance_squared(*t)))
+    };
+    let assigned: Vec<Option<(u32, f64)>> = if target_points.len() <= CHUNK {
+        target_points.iter().map(assign).collect()
+    } else {
+        target_points
+            .par_chunks(CHUNK)
+            .map(|chunk| chunk.iter().map(assign).collect::<Vec<_>>())
+            .collect::<Vec<_>>()
+            .concat()
+    };
+    let mut farthest: Vec<Option<(usize, f64)>> = vec![None; samples.len()];
+    for (j, a) in assigned.iter().enumerate() {
+        let Some((i, d2)) = *a else { continue };
+        let slot = &mut farthest[i as usize];
+        if slot.is_none_or(|(_, best)| d2 > best) {
+            *slot = Some((j, d2));
+        }
+    }
+    for (i, slot) in farthest.iter().enumerate() {
+        let (Some((j, _)), Some(&n)) = (slot, sample_normals.get(i)) else {
+            continue;
+        };
+        let (t, m) = (target_points[*j], target_normals[*j]);
+        let cos = m.dot(n);
+        if cos.is_nan() || cos < normal_dot || cos <= 0.0 {
+            continue;
+        }
+        let d = ((t - samples[i]).dot(m) / cos) * n;
+        if d.is_finite() {
+            result[i] = Some(d);
+        }
+    }
+    result
+}
+
+/// The planar loss for **fixed** projected points (the stop-gradient targets): with
+/// `s_i = Σ_k w_ik v_{f_i,k}` (barycentrics `w_i` in face `f_i`), returns
+/// `L = (1/N) Σ_i ‖s_i − q_i‖²` over the `N = faces.len()` samples (a `None` target contributes
+/// 0 but counts in N) and `∂L/∂v` (`∂L/∂s_i = 2 (s_i − q_i)/N`, scattered with `w_i`).
+/// Samples whose face is out of range are skipped. This is what [`PlanarLoss`] differentiates.
+pub fn planar_loss_fixed_targets(
+    positions: &[DVec3],
+    triangles: &[[u32; 3]],
+    faces: &[u32],
+    barycentrics: &[[f64; 3]],
+    targets: &[Option<DVec3>],
+) -> (f64, Vec<DVec3>) {
+    let mut grad = vec![DVec3::ZERO; positions.len()];
+    let n = faces.len();
+    if n == 0 {
+        return (0.0, grad);
+    }
+    let inv_n = 1.0 / n as f64;
+    let mut loss = 0.0;
+    for ((&f, w), q) in faces.iter().zip(barycentrics).zip(targets) {
+        let (Some(q), Some(tri)) = (q, triangles.get(f as usize)) else {
+            continue;
+        };
+        let Some(corners) = corner_positions(positions, tri) else {
+            continue;
+        };
+        let s = w[0] * corners[0] + w[1] * corners[1] + w[2] * corners[2];
+        let r = s - *q;
+        loss += r.length_squared();
+        let g = 2.0 * inv_n * r;
+        for k in 0..3 {
+            grad[tri[k] as usize] += w[k] * g;
+        }
+    }
+    (loss * inv_n, grad)
+}
+
+fn corner_positions(positions: &[DVec3], tri: &[u32; 3]) -> Option<[DVec3; 3]> {
+    Some([
+        *positions.get(tri[0] as usize)?,
+        *positions.get(tri[1] as usize)?,
+        *positions.get(tri[2] as usize)?,
+    ])
+}
+
+/// Indices of the samples kept under `cap` (spec: at most `cap` samples per evaluation).
+///
+/// All samples when there are at most `cap`. Otherwise each face keeps a share `p = cap/total`
+/// of its own samples, stratified: `k_f = ⌊p·m_f + u⌋` (u uniform, one draw per face, so the
+/// expected total is `cap`), picked by systematic sampling of the face's grid (stride `m_f/k_f`,
+/// random offset, one more draw), so every face keeps a spread of its samples in expectation and
+/// large faces keep proportionally more. Indices are sorted ascending; deterministic for a
+/// seeded `rng`.
+pub fn stratified_subsample(
+    samples: &RegularSamples,
+    cap: usize,
+    rng: &mut impl Rng,
+) -> Vec<usize> {
+    let total = samples.points.len();
+    if total <= cap {
+        return (0..total).collect();
+    }
+    let p = cap as f64 / total as f64;
+    let mut kept = Vec::with_capacity(cap + samples.face_n.len());
+    for f in 0..samples.face_n.len() {
+        let range = samples.face_samples(f);
+        let m = range.len();
+        let u: f64 = rng.random();
+        let k = ((p * m as f64 + u).floor() as usize).min(m);
+        if k == 0 {
+            continue;
+        }
+        let stride = m as f64 / k as f64;
+        let offset: f64 = rng.random::<f64>() * stride;
+        for j in 0..k {
+            let local = ((offset + j as f64 * stride) as usize).min(m - 1);
+            kept.push(range.start + local);
+        }
+    }
+    kept
+}
+
+/// ROAR vertex normals (spec §2.2): `N_v = Σ_{f∋v} A_f θ_{f,v} n_f`, normalized (area **times**
+/// corner angle). Degenerate faces (|cross| ≤ 1e-9) use normal (1,0,0) and area 1e-9, as the
+/// reference does. Vertices with a vanishing sum (or unreferenced) get a zero normal.
+/// Triangles with an out-of-range index are skipped.
+pub fn vertex_normals(positions: &[DVec3], triangles: &[[u32; 3]]) -> Vec<DVec3> {
+    let mut sums = vec![DVec3::ZERO; positions.len()];
+    for tri in triangles {
+        let Some(c) = corner_positions(positions, tri) else {
+            continue;
+        };
+        let cross = (c[1] - c[0]).cross(c[2] - c[0]);
+        let len = cross.length();
+        let (normal, area) = if len > 1e-9 {
+            (cross / len, 0.5 * len)
+        } else {
+            (DVec3::X, 1e-9)
+        };
+        for k in 0..3 {
+            let e1 = (c[(k + 1) % 3] - c[k]).normalize_or_zero();
+            let e2 = (c[(k + 2) % 3] - c[k]).normalize_or_zero();
+            let angle = e1.dot(e2).clamp(-1.0, 1.0).acos();
+            sums[tri[k] as usize] += area * angle * normal;
+        }
+    }
+    sums.into_iter().map(|n| n.normalize_or_zero()).collect()
+}
+
+/// Checks the source buffers: in-range indices and finite positions.
+fn check_mesh(positions: &[DVec3], triangles: &[[u32; 3]]) -> Result<(), LossError> {
+    if let Some(f) = triangles
+        .iter()
+        .position(|t| t.iter().any(|&v| v as usize >= positions.len()))
+    {
+        return Err(LossError::InvalidMesh(format!(
+            "triangle {f} refers to a missing vertex"
+        )));
+    }
+    if let Some(v) = positions.iter().position(|p| !p.is_finite()) {
+        return Err(LossError::InvalidMesh(format!(
+            "vertex {v} has a non-finite position"
+        )));
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn vertex_normals_of_a_tetrahedron_point_outward() {
+        let p = vec![
+            DVec3::new(1.0, 1.0, 1.0),
+            DVec3::new(1.0, -1.0, -1.0),
+            DVec3::new(-1.0, 1.0, -1.0),
+            DVec3::new(-1.0, -1.0, 1.0),
+        ];
+        let t = [[0, 1, 2], [0, 3, 1], [0, 2, 3], [1, 3, 2]];
+        for (v, n) in vertex_normals(&p, &t).iter().enumerate() {
+            assert!((n.dot(p[v].normalize()) - 1.0).abs() < 1e-12);
+        }
+    }
+
+    #[test]
+    fn larger_move_wins_and_none_yields() {
+        let a = [Some(DVec3::X), None, Some(DVec3::X * 3.0), None];
+        let b = [Some(DVec3::Y * 2.0), Some(DVec3::Z), Some(DVec3::Y), None];
+        let c = combine_moves(&a, &b);
+        assert_eq!(
+            c,
+            vec![
+                Some(DVec3::Y * 2.0),
+                Some(DVec3::Z),
+                Some(DVec3::X * 3.0),
+                None
+            ]
+        );
+    }
+}
