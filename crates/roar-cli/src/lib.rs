@@ -6,3 +6,4 @@
 pub mod commands;
 pub mod example;
 pub mod input;
+pub mod pipeline;

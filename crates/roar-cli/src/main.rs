@@ -18,6 +18,9 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Command {
+    /// Reconstruct a closed, oriented 2-manifold with exactly N faces and no self-intersections
+    /// from any soup (the ROAR pipeline).
+    Reconstruct(commands::reconstruct::ReconstructArgs),
     /// Vertex and face counts, bounding box, and whether the mesh is a closed 2-manifold
     /// (its genus and components if so, the first reason it is not otherwise).
     Info(commands::info::InfoArgs),
@@ -38,6 +41,7 @@ enum Command {
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
+        Command::Reconstruct(args) => commands::reconstruct::run(&args),
         Command::Info(args) => commands::info::run(&args),
         Command::Eval(args) => commands::eval::run(&args),
         Command::Render(args) => commands::render::run(&args),

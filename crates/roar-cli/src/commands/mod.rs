@@ -6,4 +6,5 @@ pub mod eval;
 pub mod example;
 pub mod info;
 pub mod init;
+pub mod reconstruct;
 pub mod render;

@@ -1,0 +1,167 @@
+//! The reconstruction's configuration: every hyper-parameter of the spec with the paper's
+//! default, each documented with the section of `spec/roar-method.md` it comes from. A TOML
+//! file overrides any subset (unknown keys are errors); the CLI's flags override the file.
+
+use serde::{Deserialize, Serialize};
+
+/// How the initial mesh M0 is made (spec §4).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum InitKind {
+    /// Watertight voxel init of the cleaned target, in the manner of Manifold (§4.1).
+    Watertight,
+    /// An icosphere of radius 0.5 (§4.2); its genus is 0, so holes of the input are lost.
+    Sphere,
+}
+
+/// Every knob of `roar reconstruct`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct ReconstructConfig {
+    /// Exact face count of the output (even). §1.1 "face budget B".
+    pub faces: usize,
+    /// Seed of every random choice (§10: seed 43).
+    pub seed: u64,
+    /// Move Vertices iterations (§1.2 step 5: 200 for ShapeNet).
+    pub iterations: usize,
+    /// Initial mesh (§4).
+    pub init: InitKind,
+    /// Voxels along the longest axis of the watertight init (replaces Manifold's octree
+    /// resolution, OQ-12).
+    pub init_resolution: usize,
+    /// The init is decimated to at most this many faces (§4.1: 20k).
+    pub init_max_faces: usize,
+    /// Subdivision level of the sphere init (§4.2: 2; more helps a sphere reach detail).
+    pub sphere_level: u32,
+    /// Working budget W = clamp(factor·N, min, max), never below N (OQ-11, §1.2 step 6).
+    pub working_budget_factor: usize,
+    /// Lower bound of the working budget.
+    pub working_budget_min: usize,
+    /// Upper bound of the working budget.
+    pub working_budget_max: usize,
+    /// Views per axis of the star rig: n² views (§3.2.1: 6 → 36).
+    pub views_per_axis: usize,
+    /// Render resolution in pixels (§3.2.1: 512).
+    pub render_resolution: u32,
+    /// Keep both twins of a soup face unless one has this many times more pixels (§3.1 a: 80).
+    pub twin_ratio: f64,
+    /// λ1, the render loss weight (§3.2.3: 3).
+    pub render_weight: f64,
+    /// λ2, the planar projection loss weight (§3.2.3: 1).
+    pub planar_weight: f64,
+    /// Scale of the planar term before its weight (Verification note 2; see `roar_loss::planar`).
+    pub planar_scale: f64,
+    /// Source samples kept per planar loss evaluation (§3.2.2 cap).
+    pub planar_max_samples: usize,
+    /// Neighbours of the k-NN planar projection (§8: s2t_neighbours 10).
+    pub planar_neighbours: usize,
+    /// Include the target-to-source term (OQ-3).
+    pub planar_t2s: bool,
+    /// Target point cloud samples (§3.1 b: 200k).
+    pub point_cloud_samples: usize,
+    /// Keep target samples whose winding number at p + 1e-3·n is below this (§3.1 b, OQ-14).
+    pub winding_threshold: f64,
+    /// Sharp-edge samples from the init (§3.1 c: 30k).
+    pub sharp_edge_samples: usize,
+    /// Learning rate η (§3.2.4: 0.05).
+    pub learning_rate: f64,
+    /// Laplacian weight of the optimizer (§8: 0.02).
+    pub laplacian_weight: f64,
+    /// Face Collapse block and flips every this many iterations (§1.3: 1).
+    pub collapse_interval: usize,
+    /// Fold estimator slack (§3.6, note 4: 0.6).
+    pub collapse_fold_slack: f64,
+    /// Face Split block every this many iterations (§1.3: 10).
+    pub split_interval: usize,
+    /// Face split score threshold per sub-triangle (§3.5, note 1: 0.02).
+    pub split_threshold: f64,
+    /// Tangential smoothing every this many iterations (§1.3, OQ-13: 5; 0 = off).
+    pub smoothing_interval: usize,
+    /// Separation margin of the untangle block, relative to the bounding-box diagonal.
+    pub untangle_margin: f64,
+    /// Write the closest mesh when the final QEM cannot reach the budget, instead of failing.
+    pub best_effort: bool,
+}
+
+impl Default for ReconstructConfig {
+    fn default() -> Self {
+        Self {
+            faces: 5000,
+            seed: 43,
+            iterations: 200,
+            init: InitKind::Watertight,
+            init_resolution: 128,
+            init_max_faces: 20_000,
+            sphere_level: 4,
+            working_budget_factor: 2,
+            working_budget_min: 5000,
+            working_budget_max: 20_000,
+            views_per_axis: 6,
+            render_resolution: 512,
+            twin_ratio: 80.0,
+            render_weight: 3.0,
+            planar_weight: 1.0,
+            planar_scale: roar_loss::planar::DEFAULT_PLANAR_SCALE,
+            planar_max_samples: 100_000,
+            planar_neighbours: 10,
+            planar_t2s: true,
+            point_cloud_samples: 200_000,
+            winding_threshold: 0.2,
+            sharp_edge_samples: 30_000,
+            learning_rate: 0.05,
+            laplacian_weight: 0.02,
+            collapse_interval: 1,
+            collapse_fold_slack: 0.6,
+            split_interval: 10,
+            split_threshold: 0.02,
+            smoothing_interval: 5,
+            untangle_margin: 1e-6,
+            best_effort: false,
+        }
+    }
+}
+
+impl ReconstructConfig {
+    /// W = clamp(factor·N, min, max), never below N (DESIGN.md §2).
+    pub fn working_budget(&self) -> usize {
+        let w = (self.working_budget_factor * self.faces)
+            .max(self.working_budget_min)
+            .min(self.working_budget_max)
+            .max(self.faces);
+        w + w % 2
+    }
+
+    /// Checks ranges a run depends on, with one-line messages.
+    pub fn validate(&self) -> Result<(), String> {
+        if self.faces % 2 == 1 {
+            return Err(format!(
+                "faces = {} is odd, but a closed triangle mesh always has an even face count; use {} or {}",
+                self.faces,
+                self.faces - 1,
+                self.faces + 1
+            ));
+        }
+        if self.faces < 4 {
+            return Err(format!(
+                "faces = {} is below the 4 faces of a tetrahedron",
+                self.faces
+            ));
+        }
+        if self.views_per_axis == 0 || self.render_resolution == 0 {
+            return Err("views_per_axis and render_resolution must be positive".into());
+        }
+        if !(self.learning_rate > 0.0 && self.learning_rate.is_finite()) {
+            return Err(format!(
+                "learning_rate = {} must be positive",
+                self.learning_rate
+            ));
+        }
+        if self.init_resolution < 8 {
+            return Err(format!(
+                "init_resolution = {} is below 8",
+                self.init_resolution
+            ));
+        }
+        Ok(())
+    }
+}

@@ -1,0 +1,539 @@
+//! The ROAR pipeline (DESIGN.md §2): from a soup to a closed, oriented 2-manifold with exactly N
+//! faces and no self-intersections.
+//!
+//! ```text
+//! soup ─weld, normalize, twin clean-up─▶ target T′ + renders
+//! T′ ─watertight init, QEM ≤ 20k─▶ M0 ;  T′ + sharp edges of M0 ─▶ point cloud P
+//! M0 ─QEM─▶ working budget W
+//! loop: loss (λ1·render + λ2·planar) → optimizer step → scheduled blocks
+//! fill to N (edge splits) → untangle → QEM to exactly N → denormalize
+//! ```
+//!
+//! A researcher swaps a piece without forking a crate: [`Reconstruction::loss_factory`] builds
+//! the objective from the prepared target, and [`Reconstruction::blocks`] is the remeshing
+//! schedule (any [`Block`]).
+
+pub mod config;
+
+use std::collections::BTreeMap;
+use std::time::Instant;
+
+use glam::DVec3;
+use roar_loss::{
+    KnnOptions, KnnPlanarProjector, Loss, LossError, PlanarLoss, PlanarOptions, PointCloud,
+    PointCloudOptions, RenderLoss, SharpEdgeOptions, Target, TargetOptions, WeightedSum,
+    build_target, point_cloud, sharp_edge_samples,
+};
+use roar_mesh::{EdgeId, Mesh};
+use roar_ops::block::{Block, BlockContext, BlockStats};
+use roar_ops::collapse_block::{FaceCollapse, FaceCollapseOptions};
+use roar_ops::init::{InitError, InitOptions, watertight_init};
+use roar_ops::optim::{Optimizer, OptimizerOptions};
+use roar_ops::qem::{DecimateError, DecimateOptions, DecimateStats, decimate};
+use roar_ops::smoothing::TangentialSmoothing;
+use roar_ops::split_block::{FaceSplit, FaceSplitOptions, SplitThreshold};
+use roar_ops::untangle::{UntangleOptions, UntangleStats, untangle};
+use serde::Serialize;
+
+pub use config::{InitKind, ReconstructConfig};
+
+/// Why a reconstruction failed.
+#[derive(Debug, thiserror::Error)]
+pub enum PipelineError {
+    /// The configuration is unusable.
+    #[error("config: {0}")]
+    Config(String),
+    /// Target preparation or a loss failed.
+    #[error("{0}")]
+    Loss(#[from] LossError),
+    /// The watertight init failed.
+    #[error("init: {0}")]
+    Init(#[from] InitError),
+    /// A mesh that must be a closed manifold is not (a bug in an operator).
+    #[error("internal: {0}")]
+    Internal(String),
+    /// The final QEM could not reach the budget.
+    #[error("{0}")]
+    Budget(#[from] DecimateError),
+    /// Self-intersections survived the untangle block.
+    #[error("{0} faces still intersect after the untangle block")]
+    Intersections(usize),
+}
+
+/// What the pipeline hands to a loss factory.
+pub struct Prepared<'a> {
+    /// The cleaned, normalized target and its renders.
+    pub target: &'a Target,
+    /// The oriented target point cloud P (with the sharp-edge samples).
+    pub cloud: &'a PointCloud,
+    /// The effective configuration.
+    pub config: &'a ReconstructConfig,
+}
+
+/// Builds the objective once the target is prepared.
+pub type LossFactory = Box<dyn Fn(&Prepared) -> Result<Box<dyn Loss>, PipelineError>>;
+
+/// A block and when it runs: at iterations `it` with `it % every == 0` (and `it > 0` when
+/// `skip_first`).
+pub struct ScheduledBlock {
+    /// The block.
+    pub block: Box<dyn Block>,
+    /// Period in iterations (0 = never).
+    pub every: usize,
+    /// Skip iteration 0 (the Face Split block does, spec §1.2).
+    pub skip_first: bool,
+}
+
+/// One progress report.
+#[derive(Debug, Clone)]
+pub struct Progress {
+    /// What is running ("target", "init", "optimize", "untangle", "decimate", …).
+    pub stage: &'static str,
+    /// Iteration within the optimize stage (0-based), or 0.
+    pub iteration: usize,
+    /// Total iterations of the optimize stage.
+    pub iterations: usize,
+    /// Last loss value (NaN before the first).
+    pub loss: f64,
+    /// Current face count (0 before the init).
+    pub faces: usize,
+}
+
+/// Summary of one run, for the JSON report.
+#[derive(Debug, Clone, Default, Serialize)]
+pub struct RunStats {
+    /// Seconds per stage, in first-run order of stage names (sorted by name in JSON).
+    pub seconds: BTreeMap<String, f64>,
+    /// Target clean-up figures.
+    pub target_faces: usize,
+    /// Twins dropped by the pixel-count rule.
+    pub twins_dropped: usize,
+    /// Point cloud size (with sharp-edge samples).
+    pub point_cloud: usize,
+    /// Faces of the voxel surface before any decimation.
+    pub init_voxel_faces: usize,
+    /// Faces of M0 after QEM to ≤ init_max_faces.
+    pub init_faces: usize,
+    /// Components (pieces) of M0.
+    pub init_components: usize,
+    /// Genus of M0 (kept to the end).
+    pub init_genus: usize,
+    /// The working budget W.
+    pub working_budget: usize,
+    /// Loss at the first and last iteration.
+    pub loss_first: f64,
+    /// See `loss_first`.
+    pub loss_last: f64,
+    /// Faces after the optimization loop.
+    pub loop_faces: usize,
+    /// Accepted operations per block over the loop, by block name.
+    pub block_accepted: BTreeMap<&'static str, usize>,
+    /// Edge splits used to fill up to N.
+    pub fill_splits: usize,
+    /// Untangle statistics.
+    pub untangle_initial_pairs: usize,
+    /// Rounds the untangle block needed.
+    pub untangle_rounds: usize,
+    /// Collapses of the final QEM.
+    pub final_collapses: usize,
+}
+
+/// The output of a run: the mesh in the input's coordinates.
+pub struct Output {
+    /// Vertex positions (denormalized).
+    pub positions: Vec<DVec3>,
+    /// Triangles (closed, oriented, 2-manifold; exactly `config.faces` of them).
+    pub triangles: Vec<[u32; 3]>,
+    /// What happened.
+    pub stats: RunStats,
+}
+
+/// A configured reconstruction whose losses and blocks can be replaced.
+pub struct Reconstruction {
+    /// Every hyper-parameter.
+    pub config: ReconstructConfig,
+    /// Builds the objective (default: λ1·render + λ2·planar, spec §3.2.3).
+    pub loss_factory: LossFactory,
+    /// The remeshing schedule (default: Face Collapse + flips every iteration, Face Split every
+    /// 10, tangential smoothing every 5; spec §1.2).
+    pub blocks: Vec<ScheduledBlock>,
+}
+
+impl Reconstruction {
+    /// The paper's pipeline for `config`.
+    pub fn new(config: ReconstructConfig) -> Self {
+        let blocks = default_blocks(&config);
+        Self {
+            config,
+            loss_factory: Box::new(default_loss),
+            blocks,
+        }
+    }
+
+    /// Runs the whole pipeline on a soup (any coordinates), reporting progress.
+    pub fn run(
+        &mut self,
+        positions: &[DVec3],
+        triangles: &[[u32; 3]],
+        progress: &mut dyn FnMut(&Progress),
+    ) -> Result<Output, PipelineError> {
+        let config = self.config.clone();
+        config.validate().map_err(PipelineError::Config)?;
+        let mut stats = RunStats::default();
+        let mut clock = StageClock::start();
+        let mut report = |stage, iteration, loss, faces| {
+            progress(&Progress {
+                stage,
+                iteration,
+                iterations: config.iterations,
+                loss,
+                faces,
+            })
+        };
+
+        report("target", 0, f64::NAN, 0);
+        let target = build_target(
+            positions,
+            triangles,
+            &TargetOptions {
+                views_per_axis: config.views_per_axis,
+                resolution: config.render_resolution,
+                twin_ratio: config.twin_ratio,
+            },
+        )?;
+        stats.target_faces = target.triangles.len();
+        stats.twins_dropped = target.stats.twins_dropped;
+        clock.lap("target");
+
+        report("init", 0, f64::NAN, 0);
+        let mut mesh = initial_mesh(&target, &config, &mut stats)?;
+        clock.lap("init");
+
+        report("point_cloud", 0, f64::NAN, mesh.n_faces());
+        let cloud = target_cloud(&target, &mesh, &config)?;
+        stats.point_cloud = cloud.points.len();
+        clock.lap("point_cloud");
+
+        let budget = config.working_budget();
+        stats.working_budget = budget;
+        if mesh.n_faces() > budget {
+            let options = DecimateOptions {
+                best_effort: true,
+                ..DecimateOptions::default()
+            };
+            decimate(&mut mesh, budget, &options)?;
+        }
+        clock.lap("working_budget_qem");
+
+        let mut loss = (self.loss_factory)(&Prepared {
+            target: &target,
+            cloud: &cloud,
+            config: &config,
+        })?;
+        let projector = KnnPlanarProjector::new(
+            &cloud.points,
+            &cloud.normals,
+            &KnnOptions {
+                k: config.planar_neighbours,
+                ..KnnOptions::default()
+            },
+        )?;
+        let mut optimizer = Optimizer::new(
+            mesh.vertex_capacity(),
+            OptimizerOptions {
+                lr: config.learning_rate,
+                laplacian_weight: config.laplacian_weight,
+                ..OptimizerOptions::default()
+            },
+        )
+        .map_err(|e| PipelineError::Config(e.to_string()))?;
+        clock.lap("loop_setup");
+
+        for iteration in 0..config.iterations {
+            let triangles = compact_triangles(&mut mesh, &mut optimizer);
+            let (value, gradient) = loss.value_and_grad(mesh.positions(), &triangles)?;
+            if iteration == 0 {
+                stats.loss_first = value;
+            }
+            stats.loss_last = value;
+            clock.lap("loop_loss");
+            optimizer
+                .step(mesh.positions_mut(), &triangles, &gradient)
+                .map_err(|e| PipelineError::Internal(e.to_string()))?;
+            clock.lap("loop_step");
+            let context = BlockContext {
+                iteration,
+                face_budget: budget,
+                projector: Some(&projector),
+            };
+            for scheduled in &mut self.blocks {
+                let due = scheduled.every > 0
+                    && iteration % scheduled.every == 0
+                    && !(scheduled.skip_first && iteration == 0);
+                if due {
+                    let block_stats = scheduled.block.apply(&mut mesh, &mut optimizer, &context);
+                    *stats.block_accepted.entry(block_stats.name).or_insert(0) +=
+                        total_accepted(&block_stats);
+                    clock.lap(&format!("loop_block_{}", scheduled.block.name()));
+                }
+            }
+            report("optimize", iteration, value, mesh.n_faces());
+        }
+        stats.loop_faces = mesh.n_faces();
+        drop(loss);
+
+        report("finish", config.iterations, stats.loss_last, mesh.n_faces());
+        stats.fill_splits = fill_to_budget(&mut mesh, config.faces);
+        clock.lap("fill_to_budget");
+
+        let untangled = untangle(
+            &mut mesh,
+            &UntangleOptions {
+                margin_rel: config.untangle_margin,
+                ..UntangleOptions::default()
+            },
+        );
+        record_untangle(&mut stats, &untangled);
+        clock.lap("untangle");
+        if !untangled.unresolved_faces.is_empty() {
+            return Err(PipelineError::Intersections(
+                untangled.unresolved_faces.len(),
+            ));
+        }
+
+        report(
+            "decimate",
+            config.iterations,
+            stats.loss_last,
+            mesh.n_faces(),
+        );
+        let decimated = final_decimation(&mut mesh, &config)?;
+        stats.final_collapses = decimated.collapses;
+        clock.lap("final_qem");
+
+        let (mut out_positions, out_triangles) = mesh.to_triangles();
+        target.normalization.invert_all(&mut out_positions);
+        stats.seconds = clock.seconds;
+        Ok(Output {
+            positions: out_positions,
+            triangles: out_triangles,
+            stats,
+        })
+    }
+}
+
+/// The default objective: `λ1·L_render + λ2·L_planar` (spec §3.2.3).
+pub fn default_loss(prepared: &Prepared) -> Result<Box<dyn Loss>, PipelineError> {
+    let config = prepared.config;
+    let planar = PlanarLoss::new(
+        &prepared.cloud.points,
+        &prepared.cloud.normals,
+        &PlanarOptions {
+            knn: KnnOptions {
+                k: config.planar_neighbours,
+                ..KnnOptions::default()
+            },
+            t2s: config.planar_t2s,
+            max_samples: config.planar_max_samples,
+            scale: config.planar_scale,
+            seed: config.seed,
+            ..PlanarOptions::default()
+        },
+    )?;
+    Ok(Box::new(
+        WeightedSum::default()
+            .with(
+                config.render_weight,
+                Box::new(RenderLoss::new(prepared.target)),
+            )
+            .with(config.planar_weight, Box::new(planar)),
+    ))
+}
+
+/// The paper's schedule (spec §1.2, §1.3).
+pub fn default_blocks(config: &ReconstructConfig) -> Vec<ScheduledBlock> {
+    vec![
+        ScheduledBlock {
+            block: Box::new(FaceCollapse {
+                options: FaceCollapseOptions {
+                    fold_slack: config.collapse_fold_slack,
+                    ..FaceCollapseOptions::default()
+                },
+            }),
+            every: config.collapse_interval,
+            skip_first: false,
+        },
+        ScheduledBlock {
+            block: Box::new(FaceSplit {
+                options: FaceSplitOptions {
+                    threshold: SplitThreshold::PerSubTriangle(config.split_threshold),
+                    seed: config.seed,
+                    ..FaceSplitOptions::default()
+                },
+            }),
+            every: config.split_interval,
+            skip_first: true,
+        },
+        ScheduledBlock {
+            block: Box::new(TangentialSmoothing::default()),
+            every: config.smoothing_interval,
+            skip_first: false,
+        },
+    ]
+}
+
+/// M0: the watertight init of T′ (or an icosphere), decimated to at most `init_max_faces`.
+fn initial_mesh(
+    target: &Target,
+    config: &ReconstructConfig,
+    stats: &mut RunStats,
+) -> Result<Mesh, PipelineError> {
+    let mut mesh = match config.init {
+        InitKind::Watertight => {
+            let init = watertight_init(
+                &target.positions,
+                &target.triangles,
+                &InitOptions {
+                    resolution: config.init_resolution,
+                    ..InitOptions::default()
+                },
+            )?;
+            Mesh::from_triangles(init.positions, &init.triangles)
+                .map_err(|e| PipelineError::Internal(format!("watertight init: {e}")))?
+        }
+        InitKind::Sphere => {
+            let mut sphere = roar_mesh::shapes::icosphere(config.sphere_level);
+            for p in sphere.positions_mut() {
+                *p *= 0.5;
+            }
+            sphere
+        }
+    };
+    stats.init_voxel_faces = mesh.n_faces();
+    if mesh.n_faces() > config.init_max_faces {
+        let options = DecimateOptions {
+            best_effort: true,
+            ..DecimateOptions::default()
+        };
+        decimate(&mut mesh, config.init_max_faces, &options)?;
+    }
+    stats.init_faces = mesh.n_faces();
+    stats.init_components = mesh.components().0;
+    stats.init_genus = mesh.genus();
+    Ok(mesh)
+}
+
+/// P: winding-filtered samples of T′ plus samples on the sharp edges of M0 (spec §3.1 b, c).
+fn target_cloud(
+    target: &Target,
+    m0: &Mesh,
+    config: &ReconstructConfig,
+) -> Result<PointCloud, PipelineError> {
+    let mut cloud = point_cloud(
+        target,
+        &PointCloudOptions {
+            samples: config.point_cloud_samples,
+            winding_threshold: config.winding_threshold,
+            seed: config.seed,
+            ..PointCloudOptions::default()
+        },
+    )?;
+    if config.sharp_edge_samples > 0 {
+        let (positions, triangles) = m0.to_triangles();
+        let sharp = sharp_edge_samples(
+            &target.bvh(),
+            &positions,
+            &triangles,
+            &SharpEdgeOptions {
+                samples: config.sharp_edge_samples,
+                seed: config.seed,
+                ..SharpEdgeOptions::default()
+            },
+        )?;
+        cloud.extend(sharp);
+    }
+    if cloud.points.is_empty() {
+        return Err(PipelineError::Loss(LossError::InvalidTarget(
+            "no target sample survived the winding-number filter".into(),
+        )));
+    }
+    Ok(cloud)
+}
+
+/// The triangles of a compact mesh (compacting it, and the optimizer with it, if needed).
+fn compact_triangles(mesh: &mut Mesh, optimizer: &mut Optimizer) -> Vec<[u32; 3]> {
+    if mesh.vertex_capacity() != mesh.n_vertices() || mesh.face_capacity() != mesh.n_faces() {
+        roar_ops::block::compact_with_optimizer(mesh, optimizer);
+    }
+    roar_ops::block::sync_optimizer_len(mesh, optimizer);
+    mesh.faces()
+        .map(|f| mesh.face_vertices(f).map(|v| v.raw()))
+        .collect()
+}
+
+/// Splits the longest edges at their midpoints until the mesh has `faces` faces (each split adds
+/// two). The geometry does not change, so no intersection can appear. Returns the split count.
+fn fill_to_budget(mesh: &mut Mesh, faces: usize) -> usize {
+    let mut splits = 0;
+    while mesh.n_faces() < faces {
+        let mut edges: Vec<(f64, EdgeId)> =
+            mesh.edges().map(|e| (mesh.edge_length(e), e)).collect();
+        // Longest first; ties by id keep it deterministic.
+        edges.sort_by(|a, b| b.0.total_cmp(&a.0).then(a.1.cmp(&b.1)));
+        let wanted = (faces - mesh.n_faces()) / 2;
+        for &(_, e) in edges.iter().take(wanted.max(1)) {
+            if mesh.n_faces() >= faces {
+                break;
+            }
+            mesh.split_edge(e, 0.5);
+            splits += 1;
+        }
+    }
+    mesh.compact();
+    splits
+}
+
+/// The guaranteed QEM to exactly `config.faces` (best effort only if configured).
+fn final_decimation(
+    mesh: &mut Mesh,
+    config: &ReconstructConfig,
+) -> Result<DecimateStats, PipelineError> {
+    let options = DecimateOptions {
+        best_effort: config.best_effort,
+        ..DecimateOptions::default()
+    };
+    Ok(decimate(mesh, config.faces, &options)?)
+}
+
+fn record_untangle(stats: &mut RunStats, untangled: &UntangleStats) {
+    stats.untangle_initial_pairs = untangled.initial_pairs;
+    stats.untangle_rounds = untangled.rounds;
+}
+
+/// Accepted operations of a block, including nested blocks (the flips of Face Collapse).
+fn total_accepted(stats: &BlockStats) -> usize {
+    stats.accepted + stats.sub.iter().map(total_accepted).sum::<usize>()
+}
+
+/// Accumulates wall time per stage name.
+struct StageClock {
+    seconds: BTreeMap<String, f64>,
+    last: Option<Instant>,
+}
+
+impl StageClock {
+    fn start() -> Self {
+        Self {
+            seconds: BTreeMap::new(),
+            last: Some(Instant::now()),
+        }
+    }
+
+    /// Charges the time since the previous lap (or since creation) to `stage`.
+    fn lap(&mut self, stage: &str) {
+        let now = Instant::now();
+        let since = self.last.unwrap_or(now);
+        *self.seconds.entry(stage.to_string()).or_insert(0.0) += (now - since).as_secs_f64();
+        self.last = Some(now);
+    }
+}
