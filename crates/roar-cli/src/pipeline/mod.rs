@@ -124,6 +124,8 @@ pub struct RunStats {
     pub loss_first: f64,
     /// See `loss_first`.
     pub loss_last: f64,
+    /// Loss and face count at every iteration.
+    pub history: Vec<(f64, usize)>,
     /// Faces after the optimization loop.
     pub loop_faces: usize,
     /// Accepted operations per block over the loop, by block name.
@@ -256,6 +258,7 @@ impl Reconstruction {
                 stats.loss_first = value;
             }
             stats.loss_last = value;
+            stats.history.push((value, mesh.n_faces()));
             clock.lap("loop_loss");
             optimizer
                 .step(mesh.positions_mut(), &triangles, &gradient)

@@ -1,0 +1,108 @@
+//! End-to-end reconstructions (release mode, run by `.ci/run` with `--ignored`): the shipped
+//! example and two small wild meshes at 1000 faces. Each output must be a closed, oriented
+//! 2-manifold with exactly the budget, no self-intersecting faces, no more components than the
+//! init, and a Chamfer distance at least 10 % below that of the init decimated to the same budget
+//! (what the optimization adds).
+
+use std::path::PathBuf;
+
+use roar_cli::pipeline::{ReconstructConfig, Reconstruction};
+use roar_eval::{ChamferOptions, fidelity};
+use roar_mesh::Mesh;
+use roar_mesh::spatial::self_intersecting_faces;
+
+const FACES: usize = 1000;
+
+fn inputs() -> Vec<PathBuf> {
+    let mut files =
+        vec![PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../examples/chair_soup.obj")];
+    match std::env::var_os("ROAR_TEST_DATA") {
+        Some(root) => {
+            let wild = PathBuf::from(root).join("wild");
+            assert!(
+                wild.is_dir(),
+                "ROAR_TEST_DATA has no wild/ folder: {}",
+                wild.display()
+            );
+            files.push(wild.join("trimesh-rabbit.obj"));
+            files.push(wild.join("manifoldplus-chair.off"));
+        }
+        None => assert!(
+            std::env::var("CI").as_deref() != Ok("true"),
+            "ROAR_TEST_DATA must be set under CI"
+        ),
+    }
+    files
+}
+
+fn chamfer_over_diag(
+    positions: &[glam::DVec3],
+    triangles: &[[u32; 3]],
+    soup: &roar_io::TriangleSoup,
+) -> f64 {
+    let options = ChamferOptions {
+        samples: 100_000,
+        seed: 7,
+    };
+    fidelity(
+        positions,
+        triangles,
+        &soup.positions,
+        &soup.triangles,
+        &options,
+    )
+    .expect("both meshes have area")
+    .chamfer_l2_over_diag
+}
+
+#[test]
+#[ignore = "minutes in release; run by .ci/run"]
+fn reconstruction_beats_init_plus_qem_and_keeps_every_promise() {
+    for path in inputs() {
+        let soup = roar_io::read_mesh(&path).unwrap();
+        let config = ReconstructConfig {
+            faces: FACES,
+            ..ReconstructConfig::default()
+        };
+
+        let baseline_config = ReconstructConfig {
+            iterations: 0,
+            ..config.clone()
+        };
+        let baseline = Reconstruction::new(baseline_config)
+            .run(&soup.positions, &soup.triangles, &mut |_| {})
+            .unwrap();
+        let started = std::time::Instant::now();
+        let out = Reconstruction::new(config)
+            .run(&soup.positions, &soup.triangles, &mut |_| {})
+            .unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+        let seconds = started.elapsed().as_secs_f64();
+
+        let name = path.file_name().unwrap().to_string_lossy().into_owned();
+        assert_eq!(out.triangles.len(), FACES, "{name}: exact budget");
+        let mesh = Mesh::from_triangles(out.positions.clone(), &out.triangles)
+            .unwrap_or_else(|e| panic!("{name}: not a closed manifold: {e}"));
+        mesh.validate().unwrap();
+        assert!(mesh.signed_volume() > 0.0, "{name}: outward orientation");
+        assert!(
+            mesh.components().0 <= out.stats.init_components,
+            "{name}: more components than the init"
+        );
+        let crossing = self_intersecting_faces(&out.positions, &out.triangles)
+            .iter()
+            .filter(|&&x| x)
+            .count();
+        assert_eq!(crossing, 0, "{name}: self-intersecting faces");
+
+        let ours = chamfer_over_diag(&out.positions, &out.triangles, &soup);
+        let init = chamfer_over_diag(&baseline.positions, &baseline.triangles, &soup);
+        eprintln!(
+            "{name}: chamfer/diag {ours:.5} vs init+QEM {init:.5} ({:+.1} %), {seconds:.1} s",
+            100.0 * (ours / init - 1.0)
+        );
+        assert!(
+            ours <= 0.9 * init,
+            "{name}: chamfer/diag {ours} is not 10 % below init + QEM {init}"
+        );
+    }
+}
