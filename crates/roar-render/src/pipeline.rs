@@ -182,7 +182,7 @@ struct ViewGrad {
 }
 
 /// Backward of one view given a seed `seed(pixel, colour) -> dL/dI` (which may also accumulate
-/// a loss).
+/// a loss). Every pixel is seeded once, in pixel order.
 fn backward_view(
     geom: &ViewGeometry,
     cam: &Camera,
@@ -193,16 +193,45 @@ fn backward_view(
     let mut d_normals = vec![DVec3::ZERO; normals.len()];
     let mut d_positions = Vec::new();
     let ids = &geom.ids;
-    shade_view(ids, &geom.items, normals, |p, img, items| {
-        let g = seed(p, img);
-        if g == [0.0; 4] {
-            return;
+    let items = &geom.items;
+    let mut next = 0;
+    let mut p = 0;
+    while p < ids.len() {
+        // Pixels up to the next AA target show their own face's colour unblended: the image
+        // gradient goes to that face's normal only.
+        let blended = items.get(next).map_or(ids.len(), |it| it.target as usize);
+        for (q, &id) in ids.iter().enumerate().take(blended).skip(p) {
+            let g = seed(q, colour(normals, id));
+            if id != BACKGROUND {
+                d_normals[id as usize] += DVec3::new(g[0], g[1], g[2]);
+            }
         }
-        let gn = DVec3::new(g[0], g[1], g[2]);
+        if blended == ids.len() {
+            break;
+        }
+        p = blended;
+        let start = next;
+        while next < items.len() && items[next].target as usize == p {
+            next += 1;
+        }
+        let pixel_items = &items[start..next];
         let id = ids[p];
         let base = colour(normals, id);
+        let mut img = base;
+        for it in pixel_items {
+            let src = colour(normals, ids[it.source as usize]);
+            for c in 0..4 {
+                img[c] += it.alpha * (src[c] - base[c]);
+            }
+        }
+        let g = seed(p, img);
+        p += 1;
+        if g == [0.0; 4] {
+            continue;
+        }
+        let gn = DVec3::new(g[0], g[1], g[2]);
         let mut own = 1.0;
-        for it in items {
+        for it in pixel_items {
             own -= it.alpha;
             let src_id = ids[it.source as usize];
             let src = colour(normals, src_id);
@@ -235,7 +264,7 @@ fn backward_view(
         if id != BACKGROUND {
             d_normals[id as usize] += gn * own;
         }
-    });
+    }
     ViewGrad {
         loss: 0.0,
         d_normals,
