@@ -436,21 +436,46 @@ pub fn render_loss_and_grad(
         let cam = &cameras[v];
         let geom = forward_view(positions, triangles, &neighbors, cam, v, opts)?;
         let target = &targets[v];
-        let mut loss = 0.0;
-        let mut r = backward_view(&geom, cam, &normals, |p, img| {
-            let t = target[p];
-            let mut g = [0.0; 4];
-            for c in 0..4 {
-                let (l, d) = loss_term(kind, img[c] - t[c] as f64);
-                loss += l;
-                g[c] = d * inv_n;
-            }
-            g
-        });
-        r.loss = loss;
-        Ok(r)
+        // One copy of the per-pixel loop per loss, so the penalty inlines without a branch.
+        Ok(match kind {
+            LossKind::L1 => view_loss_and_grad(&geom, cam, &normals, target, inv_n, |d| {
+                loss_term(LossKind::L1, d)
+            }),
+            LossKind::L2 => view_loss_and_grad(&geom, cam, &normals, target, inv_n, |d| {
+                loss_term(LossKind::L2, d)
+            }),
+        })
     })?;
     Ok((loss * inv_n, grad))
+}
+
+/// Loss and gradient of one view against its target image, `penalty(d) = (loss, dloss/dd)`
+/// per channel difference `d = I − T` (before the mean's `inv_n`).
+fn view_loss_and_grad(
+    geom: &ViewGeometry,
+    cam: &Camera,
+    normals: &[DVec3],
+    target: &[[f32; 4]],
+    inv_n: f64,
+    penalty: impl Fn(f64) -> (f64, f64),
+) -> ViewGrad {
+    let mut loss = 0.0;
+    let mut r = backward_view(geom, cam, normals, |p, img| {
+        let t = target[p];
+        if img == [0.0; 4] && t == [0.0; 4] {
+            // Background over background (a third of a typical view): no loss, no gradient.
+            return [0.0; 4];
+        }
+        let mut g = [0.0; 4];
+        for c in 0..4 {
+            let (l, d) = penalty(img[c] - t[c] as f64);
+            loss += l;
+            g[c] = d * inv_n;
+        }
+        g
+    });
+    r.loss = loss;
+    r
 }
 
 /// Number of pixels, over all views, in which each face is the visible triangle (before
