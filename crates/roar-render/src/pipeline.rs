@@ -200,7 +200,7 @@ fn backward_view(
         // Pixels up to the next AA target show their own face's colour unblended: the image
         // gradient goes to that face's normal only.
         let blended = items.get(next).map_or(ids.len(), |it| it.target as usize);
-        for (q, &id) in ids.iter().enumerate().take(blended).skip(p) {
+        for (q, &id) in (p..).zip(&ids[p..blended]) {
             let g = seed(q, colour(normals, id));
             if id != BACKGROUND {
                 d_normals[id as usize] += DVec3::new(g[0], g[1], g[2]);

@@ -44,7 +44,7 @@ fn ceil_div(a: i64, b: i64) -> i64 {
 }
 
 /// How one edge function `e(i) = e + step · i` (`i` the pixel offset in a row) limits a row.
-#[derive(Clone, Copy)]
+#[derive(Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
 enum Bound {
     /// `step > 0`: offsets `i ≥ −q` pass.
     Left,
@@ -85,24 +85,13 @@ impl EdgeStepper {
         }
     }
 
-    /// Narrows the offsets `lo..=hi` of the current row to those where `e(i) ≥ 0`.
-    fn narrow(&self, lo: i64, hi: i64) -> (i64, i64) {
-        match self.bound {
-            Bound::Left => (lo.max(-self.q), hi),
-            Bound::Right => (lo, hi.min(self.q)),
-            Bound::Flat if self.q >= 0 => (lo, hi),
-            Bound::Flat => (lo, lo - 1),
-        }
-    }
-
-    /// Moves to the next row (`e += row_step`).
+    /// Moves to the next row (`e += row_step`), without a data-dependent branch.
     fn advance(&mut self) {
         self.q += self.qt;
         self.r += self.rt;
-        if self.r >= self.d {
-            self.r -= self.d;
-            self.q += 1;
-        }
+        let carry = (self.r >= self.d) as i64;
+        self.r -= carry * self.d;
+        self.q += carry;
     }
 }
 
@@ -171,14 +160,31 @@ pub fn rasterize(
         let (zx32, zy32, zo32) = (zx as f32, zy as f32, z_origin as f32);
         let fid = f as u32;
         let mut edges = [0, 1, 2].map(|k| EdgeStepper::new(row[k], step_x[k], step_y[k]));
+        // Left bounds first, then right, then flat, so each row runs branch-free loops of
+        // per-triangle constant length.
+        edges.sort_by_key(|e| e.bound);
+        let num_left = edges.iter().filter(|e| e.bound == Bound::Left).count();
+        let num_right = edges.iter().filter(|e| e.bound == Bound::Right).count();
+        let (left, rest) = edges.split_at_mut(num_left);
+        let (right, flat) = rest.split_at_mut(num_right);
         for y in y0..=y1 {
             // The covered pixels of a row form one span (the triangle is convex): intersect the
             // half-lines where each edge function is non-negative, exactly, then only depth-test
             // inside the span.
             let mut lo = 0;
             let mut hi = x1 - x0;
-            for edge in &mut edges {
-                (lo, hi) = edge.narrow(lo, hi);
+            for edge in left.iter_mut() {
+                lo = lo.max(-edge.q);
+                edge.advance();
+            }
+            for edge in right.iter_mut() {
+                hi = hi.min(edge.q);
+                edge.advance();
+            }
+            for edge in flat.iter_mut() {
+                if edge.q < 0 {
+                    hi = lo - 1;
+                }
                 edge.advance();
             }
             if lo > hi {
