@@ -43,6 +43,16 @@ fn ceil_div(a: i64, b: i64) -> i64 {
     -((-a).div_euclid(b))
 }
 
+/// `(⌊a / d⌋, a mod d)` for `d > 0`, with one hardware division.
+fn div_mod_floor(a: i64, d: i64) -> (i64, i64) {
+    let (q, r) = (a / d, a % d);
+    if r < 0 { (q - 1, r + d) } else { (q, r) }
+}
+
+/// Triangles whose clamped bounding box has at most this many pixels are filled by testing the
+/// edge functions at every pixel, cheaper there than setting up the span stepping.
+const SMALL_BOX: i64 = 32;
+
 /// How one edge function `e(i) = e + step · i` (`i` the pixel offset in a row) limits a row.
 #[derive(Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
 enum Bound {
@@ -54,6 +64,7 @@ enum Bound {
     Flat,
 }
 
+#[derive(Clone, Copy)]
 /// Exact row-to-row tracking of where one edge function crosses zero: `q, r` with
 /// `e = q·d + r, 0 ≤ r < d` (`d = |step|`, or 1 for a flat edge), advanced by the per-row
 /// increment `row_step = qt·d + rt` with additions only (two divisions per edge and triangle
@@ -75,13 +86,15 @@ impl EdgeStepper {
             _ => Bound::Flat,
         };
         let d = step.abs().max(1);
+        let (q, r) = div_mod_floor(e, d);
+        let (qt, rt) = div_mod_floor(row_step, d);
         Self {
             bound,
-            q: e.div_euclid(d),
-            r: e.rem_euclid(d),
+            q,
+            r,
             d,
-            qt: row_step.div_euclid(d),
-            rt: row_step.rem_euclid(d),
+            qt,
+            rt,
         }
     }
 
@@ -159,10 +172,47 @@ pub fn rasterize(
         let z_origin = v0.z + zx * (x0 as f64 + 0.5 - v0.x) + zy * (y0 as f64 + 0.5 - v0.y);
         let (zx32, zy32, zo32) = (zx as f32, zy as f32, z_origin as f32);
         let fid = f as u32;
-        let mut edges = [0, 1, 2].map(|k| EdgeStepper::new(row[k], step_x[k], step_y[k]));
+        let visit = |depth: &mut [f32], ids: &mut [u32], p: usize, z: f32| {
+            let cur = depth[p];
+            if z < cur
+                || (z == cur
+                    && ids[p] != BACKGROUND
+                    && triangles[fid as usize] < triangles[ids[p] as usize])
+            {
+                depth[p] = z;
+                ids[p] = fid;
+            }
+        };
+        if (x1 - x0 + 1) * (y1 - y0 + 1) <= SMALL_BOX {
+            for y in y0..=y1 {
+                let mut e = row;
+                let z_row = zo32 + zy32 * (y - y0) as f32;
+                for x in x0..=x1 {
+                    if (e[0] | e[1] | e[2]) >= 0 {
+                        let z = z_row + zx32 * (x - x0) as f32;
+                        visit(&mut depth, &mut ids, y as usize * w + x as usize, z);
+                    }
+                    for k in 0..3 {
+                        e[k] += step_x[k];
+                    }
+                }
+                for k in 0..3 {
+                    row[k] += step_y[k];
+                }
+            }
+            continue;
+        }
         // Left bounds first, then right, then flat, so each row runs branch-free loops of
         // per-triangle constant length.
-        edges.sort_by_key(|e| e.bound);
+        let unsorted = [0, 1, 2].map(|k| EdgeStepper::new(row[k], step_x[k], step_y[k]));
+        let mut edges = unsorted;
+        let mut n = 0;
+        for bound in [Bound::Left, Bound::Right, Bound::Flat] {
+            for edge in unsorted.iter().filter(|e| e.bound == bound) {
+                edges[n] = *edge;
+                n += 1;
+            }
+        }
         let num_left = edges.iter().filter(|e| e.bound == Bound::Left).count();
         let num_right = edges.iter().filter(|e| e.bound == Bound::Right).count();
         let (left, rest) = edges.split_at_mut(num_left);
@@ -187,10 +237,10 @@ pub fn rasterize(
                 }
                 edge.advance();
             }
+            let z_row = zo32 + zy32 * (y - y0) as f32;
             if lo > hi {
                 continue;
             }
-            let z_row = zo32 + zy32 * (y - y0) as f32;
             let span = y as usize * w + (x0 + lo) as usize..y as usize * w + (x0 + hi) as usize + 1;
             let pixels = depth[span.clone()].iter_mut().zip(&mut ids[span]);
             for ((cur, id), i) in pixels.zip(lo..) {
@@ -324,11 +374,15 @@ mod tests {
             let verts: Vec<ProjectedVertex> = (0..n)
                 .map(|i| {
                     // Some vertices on pixel centres or edges, some off-screen, some random.
-                    let (mut x, mut y) =
-                        (next(&mut state) * 50.0 - 6.0, next(&mut state) * 40.0 - 5.0);
+                    // Every other case small triangles (the per-pixel path), else large ones.
+                    let scale = if case % 2 == 0 { 1.0 } else { 0.12 };
+                    let (mut x, mut y) = (
+                        (next(&mut state) * 50.0 - 6.0) * scale + 15.0 * (1.0 - scale),
+                        (next(&mut state) * 40.0 - 5.0) * scale + 12.0 * (1.0 - scale),
+                    );
                     if i % 3 == 0 {
                         x = x.floor() + 0.5;
-                        y = y.floor() + if case % 2 == 0 { 0.5 } else { 0.0 };
+                        y = y.floor() + if case % 4 < 2 { 0.5 } else { 0.0 };
                     }
                     ProjectedVertex {
                         x,
