@@ -1,5 +1,7 @@
 //! Render forward + backward at the ROAR setting: 36 views × 512², on geodesic spheres of about
 //! 10k and 100k faces (`render_loss_and_grad`, L1 against renders of a slightly larger sphere).
+// `criterion_group!` generates a public function without documentation.
+#![allow(missing_docs)]
 
 use std::collections::HashMap;
 

@@ -102,6 +102,42 @@ pub fn pixel_centre(p: u32, width: u32) -> [f64; 2] {
     [(p % width) as f64 + 0.5, (p / width) as f64 + 0.5]
 }
 
+/// Per face, bit k set when edge k is a silhouette edge in this view: no unique neighbour
+/// across it, or the neighbour folds back (both opposite vertices on the same side of the
+/// edge in screen space).
+pub fn silhouette_masks(
+    verts: &[ProjectedVertex],
+    triangles: &[[u32; 3]],
+    neighbors: &EdgeNeighbors,
+) -> Vec<u8> {
+    let xy = |v: u32| {
+        let v = &verts[v as usize];
+        [v.x, v.y]
+    };
+    triangles
+        .iter()
+        .zip(&neighbors.opposite)
+        .map(|(tri, opposite)| {
+            let mut mask = 0u8;
+            for k in 0..3 {
+                let silhouette = if opposite[k] == NO_NEIGHBOR {
+                    true
+                } else {
+                    let a = xy(tri[k]);
+                    let b = xy(tri[(k + 1) % 3]);
+                    let own = edge_fn(a, b, xy(tri[(k + 2) % 3]));
+                    let other = edge_fn(a, b, xy(opposite[k]));
+                    own * other >= 0.0
+                };
+                if silhouette {
+                    mask |= 1 << k;
+                }
+            }
+            mask
+        })
+        .collect()
+}
+
 /// Finds the antialiasing items of one view. Items come in a deterministic order (horizontal
 /// pairs row by row, then vertical pairs), then are stably sorted by target pixel.
 pub fn antialias_items(
@@ -113,38 +149,41 @@ pub fn antialias_items(
     width: u32,
     height: u32,
 ) -> Vec<AaItem> {
-    let (w, h) = (width as usize, height as usize);
-    let mut masks = vec![u8::MAX; triangles.len()];
+    let w = width as usize;
+    if w == 0 || ids.len() != w * height as usize {
+        return Vec::new();
+    }
+    let masks = silhouette_masks(verts, triangles, neighbors);
     let mut items = Vec::new();
-    let mut ctx = PairContext {
+    let ctx = PairContext {
         verts,
         triangles,
         neighbors,
         ids,
         depth,
         width,
-        masks: &mut masks,
+        masks: &masks,
     };
-    for y in 0..h {
-        let row = y * w;
-        for x in 0..w.saturating_sub(1) {
-            let p = row + x;
-            if ids[p] != ids[p + 1]
-                && let Some(item) = ctx.pair(p, p + 1, true)
+    // Most differing pairs see two faces joined by a non-silhouette edge (the same smooth
+    // surface); `pair` would return nothing for them whichever face is in front, so they are
+    // skipped here without the depth comparison.
+    let smooth = |a: u32, b: u32| ctx.smooth_across(a, b) && ctx.smooth_across(b, a);
+    for (y, row) in ids.chunks_exact(w).enumerate() {
+        for (x, (&a, &b)) in row.iter().zip(&row[1..]).enumerate() {
+            if a != b
+                && !smooth(a, b)
+                && let Some(item) = ctx.pair(y * w + x, y * w + x + 1, true)
             {
                 items.push(item);
             }
         }
     }
-    for y in 0..h.saturating_sub(1) {
-        let row = y * w;
-        for x in 0..w {
-            let p = row + x;
-            if ids[p] != ids[p + w]
-                && let Some(item) = ctx.pair(p, p + w, false)
-            {
-                items.push(item);
-            }
+    for (p, (&a, &b)) in ids.iter().zip(&ids[w.min(ids.len())..]).enumerate() {
+        if a != b
+            && !smooth(a, b)
+            && let Some(item) = ctx.pair(p, p + w, false)
+        {
+            items.push(item);
         }
     }
     items.sort_by_key(|it| it.target);
@@ -158,7 +197,7 @@ struct PairContext<'a> {
     ids: &'a [u32],
     depth: &'a [f32],
     width: u32,
-    masks: &'a mut [u8],
+    masks: &'a [u8],
 }
 
 impl PairContext<'_> {
@@ -167,34 +206,18 @@ impl PairContext<'_> {
         [v.x, v.y]
     }
 
-    /// Bit k set: edge k of face f is a silhouette edge in this view.
-    fn silhouette_mask(&mut self, f: u32) -> u8 {
-        let cached = self.masks[f as usize];
-        if cached != u8::MAX {
-            return cached;
+    /// Whether face `b` is `a`'s neighbour across an edge that is not a silhouette of `a`
+    /// (false when either is the background).
+    fn smooth_across(&self, a: u32, b: u32) -> bool {
+        if a == BACKGROUND || b == BACKGROUND {
+            return false;
         }
-        let tri = self.triangles[f as usize];
-        let mut mask = 0u8;
-        for k in 0..3 {
-            let opp = self.neighbors.opposite[f as usize][k];
-            let silhouette = if opp == NO_NEIGHBOR {
-                true
-            } else {
-                let a = self.xy(tri[k]);
-                let b = self.xy(tri[(k + 1) % 3]);
-                let own = edge_fn(a, b, self.xy(tri[(k + 2) % 3]));
-                let other = edge_fn(a, b, self.xy(opp));
-                own * other >= 0.0
-            };
-            if silhouette {
-                mask |= 1 << k;
-            }
-        }
-        self.masks[f as usize] = mask;
-        mask
+        let adjacent = self.neighbors.face[a as usize];
+        let mask = self.masks[a as usize];
+        (0..3).any(|k| adjacent[k] == b && mask & (1 << k) == 0)
     }
 
-    fn pair(&mut self, p: usize, q: usize, horizontal: bool) -> Option<AaItem> {
+    fn pair(&self, p: usize, q: usize, horizontal: bool) -> Option<AaItem> {
         let (fp, fq) = (self.ids[p], self.ids[q]);
         let p_in_front = if fp == BACKGROUND {
             false
@@ -206,12 +229,10 @@ impl PairContext<'_> {
         };
         let (front, other) = if p_in_front { (p, q) } else { (q, p) };
         let face = self.ids[front];
-        let mask = self.silhouette_mask(face);
-        // Fast exit for the common interior case: the other pixel sees the neighbour across a
+        let mask = self.masks[face as usize];
+        // Exit for the interior case: the other pixel sees the neighbour across a
         // non-silhouette edge, i.e. the same smooth surface.
-        let other_face = self.ids[other];
-        let adjacent = self.neighbors.face[face as usize];
-        if (0..3).any(|k| adjacent[k] == other_face && mask & (1 << k) == 0) {
+        if self.smooth_across(face, self.ids[other]) {
             return None;
         }
         let cf = pixel_centre(front as u32, self.width);
@@ -247,7 +268,7 @@ impl PairContext<'_> {
                 break;
             }
             face = self.neighbors.face[face as usize][k];
-            mask = self.silhouette_mask(face);
+            mask = self.masks[face as usize];
         }
         let (face, tri, k, t) = found?;
         let (a, b) = (tri[k], tri[(k + 1) % 3]);

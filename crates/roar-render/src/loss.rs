@@ -22,14 +22,9 @@ pub enum LossKind {
 pub fn loss_term(kind: LossKind, d: f64) -> (f64, f64) {
     match kind {
         LossKind::L1 => {
-            let s = if d > 0.0 {
-                1.0
-            } else if d < 0.0 {
-                -1.0
-            } else {
-                0.0
-            };
-            (d.abs(), s)
+            // sign(d) with sign(0) = 0, without branches (this runs for every pixel channel).
+            let s = (d > 0.0) as i32 - (d < 0.0) as i32;
+            (d.abs(), s as f64)
         }
         LossKind::L2 => (d * d, 2.0 * d),
     }

@@ -182,7 +182,7 @@ struct ViewGrad {
 }
 
 /// Backward of one view given a seed `seed(pixel, colour) -> dL/dI` (which may also accumulate
-/// a loss).
+/// a loss). Every pixel is seeded once, in pixel order.
 fn backward_view(
     geom: &ViewGeometry,
     cam: &Camera,
@@ -193,16 +193,45 @@ fn backward_view(
     let mut d_normals = vec![DVec3::ZERO; normals.len()];
     let mut d_positions = Vec::new();
     let ids = &geom.ids;
-    shade_view(ids, &geom.items, normals, |p, img, items| {
-        let g = seed(p, img);
-        if g == [0.0; 4] {
-            return;
+    let items = &geom.items;
+    let mut next = 0;
+    let mut p = 0;
+    while p < ids.len() {
+        // Pixels up to the next AA target show their own face's colour unblended: the image
+        // gradient goes to that face's normal only.
+        let blended = items.get(next).map_or(ids.len(), |it| it.target as usize);
+        for (q, &id) in (p..).zip(&ids[p..blended]) {
+            let g = seed(q, colour(normals, id));
+            if id != BACKGROUND {
+                d_normals[id as usize] += DVec3::new(g[0], g[1], g[2]);
+            }
         }
-        let gn = DVec3::new(g[0], g[1], g[2]);
+        if blended == ids.len() {
+            break;
+        }
+        p = blended;
+        let start = next;
+        while next < items.len() && items[next].target as usize == p {
+            next += 1;
+        }
+        let pixel_items = &items[start..next];
         let id = ids[p];
         let base = colour(normals, id);
+        let mut img = base;
+        for it in pixel_items {
+            let src = colour(normals, ids[it.source as usize]);
+            for c in 0..4 {
+                img[c] += it.alpha * (src[c] - base[c]);
+            }
+        }
+        let g = seed(p, img);
+        p += 1;
+        if g == [0.0; 4] {
+            continue;
+        }
+        let gn = DVec3::new(g[0], g[1], g[2]);
         let mut own = 1.0;
-        for it in items {
+        for it in pixel_items {
             own -= it.alpha;
             let src_id = ids[it.source as usize];
             let src = colour(normals, src_id);
@@ -235,7 +264,7 @@ fn backward_view(
         if id != BACKGROUND {
             d_normals[id as usize] += gn * own;
         }
-    });
+    }
     ViewGrad {
         loss: 0.0,
         d_normals,
@@ -407,21 +436,46 @@ pub fn render_loss_and_grad(
         let cam = &cameras[v];
         let geom = forward_view(positions, triangles, &neighbors, cam, v, opts)?;
         let target = &targets[v];
-        let mut loss = 0.0;
-        let mut r = backward_view(&geom, cam, &normals, |p, img| {
-            let t = target[p];
-            let mut g = [0.0; 4];
-            for c in 0..4 {
-                let (l, d) = loss_term(kind, img[c] - t[c] as f64);
-                loss += l;
-                g[c] = d * inv_n;
-            }
-            g
-        });
-        r.loss = loss;
-        Ok(r)
+        // One copy of the per-pixel loop per loss, so the penalty inlines without a branch.
+        Ok(match kind {
+            LossKind::L1 => view_loss_and_grad(&geom, cam, &normals, target, inv_n, |d| {
+                loss_term(LossKind::L1, d)
+            }),
+            LossKind::L2 => view_loss_and_grad(&geom, cam, &normals, target, inv_n, |d| {
+                loss_term(LossKind::L2, d)
+            }),
+        })
     })?;
     Ok((loss * inv_n, grad))
+}
+
+/// Loss and gradient of one view against its target image, `penalty(d) = (loss, dloss/dd)`
+/// per channel difference `d = I − T` (before the mean's `inv_n`).
+fn view_loss_and_grad(
+    geom: &ViewGeometry,
+    cam: &Camera,
+    normals: &[DVec3],
+    target: &[[f32; 4]],
+    inv_n: f64,
+    penalty: impl Fn(f64) -> (f64, f64),
+) -> ViewGrad {
+    let mut loss = 0.0;
+    let mut r = backward_view(geom, cam, normals, |p, img| {
+        let t = target[p];
+        if img == [0.0; 4] && t == [0.0; 4] {
+            // Background over background (a third of a typical view): no loss, no gradient.
+            return [0.0; 4];
+        }
+        let mut g = [0.0; 4];
+        for c in 0..4 {
+            let (l, d) = penalty(img[c] - t[c] as f64);
+            loss += l;
+            g[c] = d * inv_n;
+        }
+        g
+    });
+    r.loss = loss;
+    r
 }
 
 /// Number of pixels, over all views, in which each face is the visible triangle (before

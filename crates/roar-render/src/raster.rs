@@ -43,6 +43,71 @@ fn ceil_div(a: i64, b: i64) -> i64 {
     -((-a).div_euclid(b))
 }
 
+/// `(⌊a / d⌋, a mod d)` for `d > 0`, with one hardware division.
+fn div_mod_floor(a: i64, d: i64) -> (i64, i64) {
+    let (q, r) = (a / d, a % d);
+    if r < 0 { (q - 1, r + d) } else { (q, r) }
+}
+
+/// Triangles whose clamped bounding box has at most this many pixels are filled by testing the
+/// edge functions at every pixel, cheaper there than setting up the span stepping.
+const SMALL_BOX: i64 = 32;
+
+/// How one edge function `e(i) = e + step · i` (`i` the pixel offset in a row) limits a row.
+#[derive(Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
+enum Bound {
+    /// `step > 0`: offsets `i ≥ −q` pass.
+    Left,
+    /// `step < 0`: offsets `i ≤ q` pass.
+    Right,
+    /// `step = 0`: the whole row passes iff `q ≥ 0` (`q` is then the edge function itself).
+    Flat,
+}
+
+#[derive(Clone, Copy)]
+/// Exact row-to-row tracking of where one edge function crosses zero: `q, r` with
+/// `e = q·d + r, 0 ≤ r < d` (`d = |step|`, or 1 for a flat edge), advanced by the per-row
+/// increment `row_step = qt·d + rt` with additions only (two divisions per edge and triangle
+/// instead of one per row, and no per-pixel edge tests).
+struct EdgeStepper {
+    bound: Bound,
+    q: i64,
+    r: i64,
+    d: i64,
+    qt: i64,
+    rt: i64,
+}
+
+impl EdgeStepper {
+    fn new(e: i64, step: i64, row_step: i64) -> Self {
+        let bound = match step.signum() {
+            1 => Bound::Left,
+            -1 => Bound::Right,
+            _ => Bound::Flat,
+        };
+        let d = step.abs().max(1);
+        let (q, r) = div_mod_floor(e, d);
+        let (qt, rt) = div_mod_floor(row_step, d);
+        Self {
+            bound,
+            q,
+            r,
+            d,
+            qt,
+            rt,
+        }
+    }
+
+    /// Moves to the next row (`e += row_step`), without a data-dependent branch.
+    fn advance(&mut self) {
+        self.q += self.qt;
+        self.r += self.rt;
+        let carry = (self.r >= self.d) as i64;
+        self.r -= carry * self.d;
+        self.q += carry;
+    }
+}
+
 /// Rasterizes `triangles` over `verts` (already projected, all in front of the near plane).
 pub fn rasterize(
     verts: &[ProjectedVertex],
@@ -107,32 +172,276 @@ pub fn rasterize(
         let z_origin = v0.z + zx * (x0 as f64 + 0.5 - v0.x) + zy * (y0 as f64 + 0.5 - v0.y);
         let (zx32, zy32, zo32) = (zx as f32, zy as f32, z_origin as f32);
         let fid = f as u32;
-        for y in y0..=y1 {
-            let mut e = row;
-            let z_row = zo32 + zy32 * (y - y0) as f32;
-            let base = y as usize * w;
-            for x in x0..=x1 {
-                if (e[0] | e[1] | e[2]) >= 0 {
-                    let z = z_row + zx32 * (x - x0) as f32;
-                    let p = base + x as usize;
-                    let cur = depth[p];
-                    if z < cur
-                        || (z == cur
-                            && ids[p] != BACKGROUND
-                            && triangles[fid as usize] < triangles[ids[p] as usize])
-                    {
-                        depth[p] = z;
-                        ids[p] = fid;
+        let visit = |depth: &mut [f32], ids: &mut [u32], p: usize, z: f32| {
+            let cur = depth[p];
+            if z < cur
+                || (z == cur
+                    && ids[p] != BACKGROUND
+                    && triangles[fid as usize] < triangles[ids[p] as usize])
+            {
+                depth[p] = z;
+                ids[p] = fid;
+            }
+        };
+        if (x1 - x0 + 1) * (y1 - y0 + 1) <= SMALL_BOX {
+            for y in y0..=y1 {
+                let mut e = row;
+                let z_row = zo32 + zy32 * (y - y0) as f32;
+                for x in x0..=x1 {
+                    if (e[0] | e[1] | e[2]) >= 0 {
+                        let z = z_row + zx32 * (x - x0) as f32;
+                        visit(&mut depth, &mut ids, y as usize * w + x as usize, z);
+                    }
+                    for k in 0..3 {
+                        e[k] += step_x[k];
                     }
                 }
-                e[0] += step_x[0];
-                e[1] += step_x[1];
-                e[2] += step_x[2];
+                for k in 0..3 {
+                    row[k] += step_y[k];
+                }
             }
-            row[0] += step_y[0];
-            row[1] += step_y[1];
-            row[2] += step_y[2];
+            continue;
+        }
+        // Left bounds first, then right, then flat, so each row runs branch-free loops of
+        // per-triangle constant length.
+        let unsorted = [0, 1, 2].map(|k| EdgeStepper::new(row[k], step_x[k], step_y[k]));
+        let mut edges = unsorted;
+        let mut n = 0;
+        for bound in [Bound::Left, Bound::Right, Bound::Flat] {
+            for edge in unsorted.iter().filter(|e| e.bound == bound) {
+                edges[n] = *edge;
+                n += 1;
+            }
+        }
+        let num_left = edges.iter().filter(|e| e.bound == Bound::Left).count();
+        let num_right = edges.iter().filter(|e| e.bound == Bound::Right).count();
+        let (left, rest) = edges.split_at_mut(num_left);
+        let (right, flat) = rest.split_at_mut(num_right);
+        for y in y0..=y1 {
+            // The covered pixels of a row form one span (the triangle is convex): intersect the
+            // half-lines where each edge function is non-negative, exactly, then only depth-test
+            // inside the span.
+            let mut lo = 0;
+            let mut hi = x1 - x0;
+            for edge in left.iter_mut() {
+                lo = lo.max(-edge.q);
+                edge.advance();
+            }
+            for edge in right.iter_mut() {
+                hi = hi.min(edge.q);
+                edge.advance();
+            }
+            for edge in flat.iter_mut() {
+                if edge.q < 0 {
+                    hi = lo - 1;
+                }
+                edge.advance();
+            }
+            let z_row = zo32 + zy32 * (y - y0) as f32;
+            if lo > hi {
+                continue;
+            }
+            let span = y as usize * w + (x0 + lo) as usize..y as usize * w + (x0 + hi) as usize + 1;
+            let pixels = depth[span.clone()].iter_mut().zip(&mut ids[span]);
+            for ((cur, id), i) in pixels.zip(lo..) {
+                let z = z_row + zx32 * i as f32;
+                if z < *cur
+                    || (z == *cur
+                        && *id != BACKGROUND
+                        && triangles[fid as usize] < triangles[*id as usize])
+                {
+                    *cur = z;
+                    *id = fid;
+                }
+            }
         }
     }
     RasterBuffers { ids, depth }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The straightforward rasterizer: edge functions tested at every pixel of the bounding box.
+    fn rasterize_per_pixel(
+        verts: &[ProjectedVertex],
+        triangles: &[[u32; 3]],
+        width: u32,
+        height: u32,
+        cull_backfaces: bool,
+    ) -> RasterBuffers {
+        let (w, h) = (width as usize, height as usize);
+        let mut ids = vec![BACKGROUND; w * h];
+        let mut depth = vec![f32::INFINITY; w * h];
+        // Snap once per vertex so shared edges get identical fixed-point endpoints.
+        let snapped: Vec<[i64; 2]> = verts.iter().map(|v| [snap(v.x), snap(v.y)]).collect();
+        let max_x = w as i64 - 1;
+        let max_y = h as i64 - 1;
+        for (f, tri) in triangles.iter().enumerate() {
+            let [i0, i1, i2] = tri.map(|i| i as usize);
+            let (q0, q1, q2) = (snapped[i0], snapped[i1], snapped[i2]);
+            let area = (q1[0] - q0[0]) * (q2[1] - q0[1]) - (q1[1] - q0[1]) * (q2[0] - q0[0]);
+            if area == 0 || (cull_backfaces && area > 0) {
+                continue;
+            }
+            // Orient so that inside means all three edge functions are positive.
+            let corners = if area > 0 { [q0, q1, q2] } else { [q0, q2, q1] };
+            let min_x = corners.iter().map(|c| c[0]).min().unwrap_or(0);
+            let max_cx = corners.iter().map(|c| c[0]).max().unwrap_or(0);
+            let min_y = corners.iter().map(|c| c[1]).min().unwrap_or(0);
+            let max_cy = corners.iter().map(|c| c[1]).max().unwrap_or(0);
+            let x0 = ceil_div(min_x - HALF, ONE).max(0);
+            let x1 = floor_div(max_cx - HALF, ONE).min(max_x);
+            let y0 = ceil_div(min_y - HALF, ONE).max(0);
+            let y1 = floor_div(max_cy - HALF, ONE).min(max_y);
+            if x0 > x1 || y0 > y1 {
+                continue;
+            }
+            // Edge functions E(p) = cross(b − a, p − a), biased by the tie rule, at the first centre.
+            let px0 = x0 * ONE + HALF;
+            let py0 = y0 * ONE + HALF;
+            let mut row = [0i64; 3];
+            let mut step_x = [0i64; 3];
+            let mut step_y = [0i64; 3];
+            for k in 0..3 {
+                let a = corners[k];
+                let b = corners[(k + 1) % 3];
+                let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
+                let include_ties = dy > 0 || (dy == 0 && dx < 0);
+                let bias = if include_ties { 0 } else { -1 };
+                row[k] = dx * (py0 - a[1]) - dy * (px0 - a[0]) + bias;
+                step_x[k] = -dy * ONE;
+                step_y[k] = dx * ONE;
+            }
+            // Depth plane z = z0 + zx (x − x0) + zy (y − y0) in float pixel coordinates.
+            let (v0, v1, v2) = (&verts[i0], &verts[i1], &verts[i2]);
+            let (d1x, d1y, d1z) = (v1.x - v0.x, v1.y - v0.y, v1.z - v0.z);
+            let (d2x, d2y, d2z) = (v2.x - v0.x, v2.y - v0.y, v2.z - v0.z);
+            let det = d1x * d2y - d1y * d2x;
+            let (zx, zy) = if det != 0.0 {
+                ((d1z * d2y - d2z * d1y) / det, (d2z * d1x - d1z * d2x) / det)
+            } else {
+                (0.0, 0.0)
+            };
+            let z_origin = v0.z + zx * (x0 as f64 + 0.5 - v0.x) + zy * (y0 as f64 + 0.5 - v0.y);
+            let (zx32, zy32, zo32) = (zx as f32, zy as f32, z_origin as f32);
+            let fid = f as u32;
+            for y in y0..=y1 {
+                let mut e = row;
+                let z_row = zo32 + zy32 * (y - y0) as f32;
+                let base = y as usize * w;
+                for x in x0..=x1 {
+                    if (e[0] | e[1] | e[2]) >= 0 {
+                        let z = z_row + zx32 * (x - x0) as f32;
+                        let p = base + x as usize;
+                        let cur = depth[p];
+                        if z < cur
+                            || (z == cur
+                                && ids[p] != BACKGROUND
+                                && triangles[fid as usize] < triangles[ids[p] as usize])
+                        {
+                            depth[p] = z;
+                            ids[p] = fid;
+                        }
+                    }
+                    e[0] += step_x[0];
+                    e[1] += step_x[1];
+                    e[2] += step_x[2];
+                }
+                row[0] += step_y[0];
+                row[1] += step_y[1];
+                row[2] += step_y[2];
+            }
+        }
+        RasterBuffers { ids, depth }
+    }
+
+    /// Tiny deterministic generator (xorshift) for the brute-force comparison.
+    fn next(state: &mut u64) -> f64 {
+        *state ^= *state << 13;
+        *state ^= *state >> 7;
+        *state ^= *state << 17;
+        (*state >> 11) as f64 / (1u64 << 53) as f64
+    }
+
+    #[test]
+    fn span_rasterizer_matches_per_pixel_edge_tests() {
+        let mut state = 0x9e37_79b9_7f4a_7c15u64;
+        let (w, h) = (37u32, 29u32);
+        for case in 0..200 {
+            let n = 3 + case % 7;
+            let verts: Vec<ProjectedVertex> = (0..n)
+                .map(|i| {
+                    // Some vertices on pixel centres or edges, some off-screen, some random.
+                    // Every other case small triangles (the per-pixel path), else large ones.
+                    let scale = if case % 2 == 0 { 1.0 } else { 0.12 };
+                    let (mut x, mut y) = (
+                        (next(&mut state) * 50.0 - 6.0) * scale + 15.0 * (1.0 - scale),
+                        (next(&mut state) * 40.0 - 5.0) * scale + 12.0 * (1.0 - scale),
+                    );
+                    if i % 3 == 0 {
+                        x = x.floor() + 0.5;
+                        y = y.floor() + if case % 4 < 2 { 0.5 } else { 0.0 };
+                    }
+                    ProjectedVertex {
+                        x,
+                        y,
+                        z: next(&mut state),
+                        cx: 0.0,
+                        cy: 0.0,
+                        w: 1.0,
+                    }
+                })
+                .collect();
+            let tris: Vec<[u32; 3]> = (0..2 * n)
+                .map(|_| [0, 1, 2].map(|_| (next(&mut state) * n as f64) as u32 % n))
+                .collect();
+            for cull in [false, true] {
+                let fast = rasterize(&verts, &tris, w, h, cull);
+                let slow = rasterize_per_pixel(&verts, &tris, w, h, cull);
+                assert_eq!(fast, slow, "case {case}, cull {cull}");
+            }
+        }
+        // Long thin slivers: steep and shallow edges over a wide image.
+        let sliver = [
+            ProjectedVertex {
+                x: 0.3,
+                y: 0.2,
+                z: 0.1,
+                cx: 0.0,
+                cy: 0.0,
+                w: 1.0,
+            },
+            ProjectedVertex {
+                x: 500.7,
+                y: 3.1,
+                z: 0.5,
+                cx: 0.0,
+                cy: 0.0,
+                w: 1.0,
+            },
+            ProjectedVertex {
+                x: 250.5,
+                y: 300.5,
+                z: 0.9,
+                cx: 0.0,
+                cy: 0.0,
+                w: 1.0,
+            },
+            ProjectedVertex {
+                x: 1.2,
+                y: 511.0,
+                z: 0.3,
+                cx: 0.0,
+                cy: 0.0,
+                w: 1.0,
+            },
+        ];
+        let tris = [[0, 1, 2], [0, 2, 3], [1, 3, 2], [0, 1, 3]];
+        assert_eq!(
+            rasterize(&sliver, &tris, 512, 512, false),
+            rasterize_per_pixel(&sliver, &tris, 512, 512, false)
+        );
+    }
 }
