@@ -18,7 +18,6 @@
 //! [`sdf_init`] builds the same kind of mesh from the negative cells of a signed distance function
 //! (spec §4.3), through the same repair and extraction code.
 
-mod closest;
 mod grid;
 mod pieces;
 mod project;
@@ -26,10 +25,9 @@ mod solid;
 mod surface;
 mod voxelize;
 
-pub use closest::ClosestPointGrid;
-
 use glam::DVec3;
 use grid::{Grid, SOLID};
+use roar_mesh::spatial::TriangleBvh;
 use thiserror::Error;
 
 /// Options of [`watertight_init`]. Lengths are in voxels.
@@ -200,20 +198,16 @@ pub enum InitError {
     EmptyResult,
 }
 
-/// Builds the watertight initial mesh of a triangle soup, projecting onto the soup itself with the
-/// built-in [`ClosestPointGrid`]. See the module doc for the steps and guarantees.
+/// Builds the watertight initial mesh of a triangle soup, projecting onto the soup itself with a
+/// [`TriangleBvh`] over the input. See the module doc for the steps and guarantees.
 pub fn watertight_init(
     positions: &[DVec3],
     triangles: &[[u32; 3]],
     options: &InitOptions,
 ) -> Result<WatertightInit, InitError> {
     let soup = valid_triangles(positions, triangles)?;
-    let cells = options.resolution.clamp(1, 256);
-    let grid =
-        ClosestPointGrid::from_triangles(soup.clone(), cells).ok_or(InitError::AllDegenerate {
-            count: triangles.len(),
-        })?;
-    let closest = |p: DVec3| grid.closest_point(p);
+    let bvh = TriangleBvh::build(positions, triangles);
+    let closest = |p: DVec3| bvh.closest_point(p).map(|c| c.point);
     watertight_init_from(&soup, triangles.len(), options, &closest)
 }
 
