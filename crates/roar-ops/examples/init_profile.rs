@@ -1,21 +1,30 @@
-//! Times the watertight init on the given mesh files (for profiling with callgrind):
-//! `cargo run --release -p roar-ops --example init_profile -- FILE...`.
+//! Times the initial mesh (watertight init, then QEM to ≤ 20k faces) on the given mesh files, for
+//! profiling: `cargo run --release -p roar-ops --example init_profile -- FILE...`.
+//! `ROAR_MAX_FACES=N` changes the face cap.
 
-use roar_ops::init::{InitOptions, watertight_init};
+use roar_ops::init::{InitialMeshOptions, initial_mesh};
 use std::path::Path;
-use std::time::Instant;
 
 fn main() {
+    let max_faces = std::env::var("ROAR_MAX_FACES")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(20_000);
+    let options = InitialMeshOptions {
+        max_faces,
+        ..InitialMeshOptions::default()
+    };
     for arg in std::env::args().skip(1) {
         let soup = roar_io::read_mesh(Path::new(&arg)).expect("readable mesh");
-        let start = Instant::now();
-        let out = watertight_init(&soup.positions, &soup.triangles, &InitOptions::default())
-            .expect("init succeeds");
+        let (_, stats) =
+            initial_mesh(&soup.positions, &soup.triangles, &options).expect("initial mesh");
         println!(
-            "{arg}: {:.2}s, {} input faces -> {} faces",
-            start.elapsed().as_secs_f64(),
-            soup.triangles.len(),
-            out.triangles.len()
+            "{arg}: init {:.2}s ({} faces), build {:.2}s, decimate {:.2}s -> {} faces",
+            stats.init_seconds,
+            stats.init_faces,
+            stats.build_seconds,
+            stats.decimate_seconds,
+            stats.final_faces
         );
     }
 }

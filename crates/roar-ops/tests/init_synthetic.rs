@@ -7,8 +7,7 @@ use common::{Soup, append, box_soup, check_closed_manifold, count_self_intersect
 use glam::DVec3;
 use roar_mesh::spatial::TriangleBvh;
 use roar_ops::init::{
-    InitError, InitOptions, SdfInitOptions, WatertightInit, sdf_init,
-    watertight_init,
+    InitError, InitOptions, SdfInitOptions, WatertightInit, sdf_init, watertight_init,
 };
 
 fn options(resolution: usize) -> InitOptions {

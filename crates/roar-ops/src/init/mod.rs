@@ -19,11 +19,14 @@
 //! (spec §4.3), through the same repair and extraction code.
 
 mod grid;
+mod initial;
 mod pieces;
 mod project;
 mod solid;
 mod surface;
 mod voxelize;
+
+pub use initial::{InitialMeshOptions, InitialMeshStats, initial_mesh};
 
 use glam::DVec3;
 use grid::{Grid, SOLID};
@@ -193,6 +196,10 @@ pub enum InitError {
         /// Passes made.
         passes: usize,
     },
+    /// A later stage of [`initial_mesh`] failed on the init's output (a bug; please report the
+    /// input).
+    #[error("initial mesh: {0}")]
+    Internal(String),
     /// Nothing is left (e.g. an SDF that is nowhere negative inside the bounds).
     #[error("the result is empty")]
     EmptyResult,
