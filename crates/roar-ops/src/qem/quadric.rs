@@ -72,7 +72,9 @@ impl Quadric {
         let c12 = xy * xz - xx * yz;
         let c22 = xx * yy - xy * xy;
         let det = xx * c00 + xy * c01 + xz * c02;
-        if !(det > 1e-8 * trace * trace * trace) {
+        // NaN fails the comparison and is rejected too.
+        let well_conditioned = det > 1e-8 * trace * trace * trace;
+        if !well_conditioned {
             return None;
         }
         let r = -self.b;
