@@ -6,7 +6,8 @@ mod common;
 
 use common::{check_closed_manifold, load};
 use glam::DVec3;
-use roar_ops::init::{ClosestPointGrid, InitOptions, watertight_init};
+use roar_mesh::spatial::TriangleBvh;
+use roar_ops::init::{InitOptions, watertight_init};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -33,10 +34,10 @@ fn data_dir() -> Option<PathBuf> {
     }
 }
 
-fn mean_distance(grid: &ClosestPointGrid, points: &[DVec3]) -> f64 {
+fn mean_distance(grid: &TriangleBvh, points: &[DVec3]) -> f64 {
     points
         .iter()
-        .map(|p| (grid.closest_point(*p).unwrap() - *p).length())
+        .map(|p| grid.closest_point(*p).unwrap().distance_squared.sqrt())
         .sum::<f64>()
         / points.len() as f64
 }
@@ -60,8 +61,8 @@ fn check_file(path: &Path) -> f64 {
         .iter()
         .fold((used[0], used[0]), |(lo, hi), p| (lo.min(*p), hi.max(*p)));
     let diag = (max - min).length();
-    let soup_grid = ClosestPointGrid::build(&soup.positions, &soup.triangles, 128).unwrap();
-    let out_grid = ClosestPointGrid::build(&out.positions, &out.triangles, 128).unwrap();
+    let soup_grid = TriangleBvh::build(&soup.positions, &soup.triangles);
+    let out_grid = TriangleBvh::build(&out.positions, &out.triangles);
     let forward = mean_distance(&soup_grid, &out.positions) / diag;
     let backward = mean_distance(&out_grid, &used) / diag;
     println!(

@@ -5,9 +5,9 @@ mod common;
 
 use common::{Soup, append, box_soup, check_closed_manifold, count_self_intersections};
 use glam::DVec3;
+use roar_mesh::spatial::TriangleBvh;
 use roar_ops::init::{
-    ClosestPointGrid, InitError, InitOptions, SdfInitOptions, WatertightInit, sdf_init,
-    watertight_init,
+    InitError, InitOptions, SdfInitOptions, WatertightInit, sdf_init, watertight_init,
 };
 
 fn options(resolution: usize) -> InitOptions {
@@ -34,10 +34,10 @@ fn assert_valid(out: &WatertightInit) -> (usize, i64) {
 }
 
 fn mean_distance_to(soup: &Soup, points: &[DVec3]) -> f64 {
-    let grid = ClosestPointGrid::build(&soup.positions, &soup.triangles, 32).unwrap();
+    let grid = TriangleBvh::build(&soup.positions, &soup.triangles);
     points
         .iter()
-        .map(|p| (grid.closest_point(*p).unwrap() - *p).length())
+        .map(|p| grid.closest_point(*p).unwrap().distance_squared.sqrt())
         .sum::<f64>()
         / points.len() as f64
 }

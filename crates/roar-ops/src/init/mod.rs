@@ -18,18 +18,19 @@
 //! [`sdf_init`] builds the same kind of mesh from the negative cells of a signed distance function
 //! (spec §4.3), through the same repair and extraction code.
 
-mod closest;
 mod grid;
+mod initial;
 mod pieces;
 mod project;
 mod solid;
 mod surface;
 mod voxelize;
 
-pub use closest::ClosestPointGrid;
+pub use initial::{InitialMeshOptions, InitialMeshStats, initial_mesh};
 
 use glam::DVec3;
 use grid::{Grid, SOLID};
+use roar_mesh::spatial::TriangleBvh;
 use thiserror::Error;
 
 /// Options of [`watertight_init`]. Lengths are in voxels.
@@ -195,26 +196,76 @@ pub enum InitError {
         /// Passes made.
         passes: usize,
     },
+    /// A later stage of [`initial_mesh`] failed on the init's output (a bug; please report the
+    /// input).
+    #[error("initial mesh: {0}")]
+    Internal(String),
     /// Nothing is left (e.g. an SDF that is nowhere negative inside the bounds).
     #[error("the result is empty")]
     EmptyResult,
 }
 
-/// Builds the watertight initial mesh of a triangle soup, projecting onto the soup itself with the
-/// built-in [`ClosestPointGrid`]. See the module doc for the steps and guarantees.
+/// Builds the watertight initial mesh of a triangle soup, projecting onto the soup itself with a
+/// [`TriangleBvh`] over the input. See the module doc for the steps and guarantees.
 pub fn watertight_init(
     positions: &[DVec3],
     triangles: &[[u32; 3]],
     options: &InitOptions,
 ) -> Result<WatertightInit, InitError> {
     let soup = valid_triangles(positions, triangles)?;
-    let cells = options.resolution.clamp(1, 256);
-    let grid =
-        ClosestPointGrid::from_triangles(soup.clone(), cells).ok_or(InitError::AllDegenerate {
-            count: triangles.len(),
-        })?;
-    let closest = |p: DVec3| grid.closest_point(p);
+    let (min, max) = soup_bounds(&soup);
+    let voxel = (max - min).max_element() / options.resolution.max(1) as f64;
+    let (split_positions, split_triangles) = split_long_edges(&soup, 4.0 * voxel);
+    let bvh = TriangleBvh::build(&split_positions, &split_triangles);
+    let closest = |p: DVec3| bvh.closest_point(p).map(|c| c.point);
     watertight_init_from(&soup, triangles.len(), options, &closest)
+}
+
+/// Most triangles [`split_long_edges`] produces; past it, long edges are left as they are.
+const MAX_SPLIT_TRIANGLES: usize = 4_000_000;
+
+/// The same surface as `soup`, with every triangle cut at the midpoint of its longest edge until no
+/// edge is longer than `max_edge`. Closest points are unchanged, but a BVH over the pieces has
+/// small boxes, so a query opens few faces even when the soup has huge triangles (a few big
+/// triangles overlapping every box made queries test almost every face).
+fn split_long_edges(soup: &[[DVec3; 3]], max_edge: f64) -> (Vec<DVec3>, Vec<[u32; 3]>) {
+    let mut out: Vec<[DVec3; 3]> = Vec::with_capacity(soup.len());
+    let mut stack: Vec<[DVec3; 3]> = Vec::new();
+    let limit2 = max_edge * max_edge;
+    for t in soup {
+        stack.push(*t);
+        while let Some(t) = stack.pop() {
+            let lengths = [0, 1, 2].map(|k| t[k].distance_squared(t[(k + 1) % 3]));
+            let k = (0..3)
+                .max_by(|&a, &b| lengths[a].total_cmp(&lengths[b]))
+                .unwrap_or(0);
+            if lengths[k] <= limit2 || out.len() + stack.len() >= MAX_SPLIT_TRIANGLES {
+                out.push(t);
+                continue;
+            }
+            let (a, b, c) = (t[k], t[(k + 1) % 3], t[(k + 2) % 3]);
+            let m = 0.5 * (a + b);
+            stack.push([a, m, c]);
+            stack.push([m, b, c]);
+        }
+    }
+    let positions: Vec<DVec3> = out.iter().flatten().copied().collect();
+    let triangles = (0..out.len() as u32)
+        .map(|f| [3 * f, 3 * f + 1, 3 * f + 2])
+        .collect();
+    (positions, triangles)
+}
+
+/// Bounding box of the soup's corners.
+fn soup_bounds(soup: &[[DVec3; 3]]) -> (DVec3, DVec3) {
+    let (mut min, mut max) = (soup[0][0], soup[0][0]);
+    for t in soup {
+        for p in t {
+            min = min.min(*p);
+            max = max.max(*p);
+        }
+    }
+    (min, max)
 }
 
 /// Like [`watertight_init`], but the projection step moves the surface toward `closest(p)`, the
@@ -298,13 +349,7 @@ fn watertight_init_from(
     closest: &(dyn Fn(DVec3) -> Option<DVec3> + Sync),
 ) -> Result<WatertightInit, InitError> {
     check_options(options)?;
-    let (mut min, mut max) = (soup[0][0], soup[0][0]);
-    for t in soup {
-        for p in t {
-            min = min.min(*p);
-            max = max.max(*p);
-        }
-    }
+    let (min, max) = soup_bounds(soup);
     if (max - min).max_element() <= 0.0 {
         return Err(InitError::ZeroExtent);
     }
@@ -434,4 +479,33 @@ pub fn sdf_init(
         triangles: pieces.triangles,
         stats,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn splitting_long_edges_keeps_the_surface_and_bounds_the_edges() {
+        let soup = vec![[
+            DVec3::ZERO,
+            DVec3::new(10.0, 0.0, 0.0),
+            DVec3::new(0.0, 3.0, 1.0),
+        ]];
+        let area = |t: [DVec3; 3]| 0.5 * (t[1] - t[0]).cross(t[2] - t[0]).length();
+        let (positions, triangles) = split_long_edges(&soup, 1.0);
+        assert!(triangles.len() > 20);
+        let mut total = 0.0;
+        for t in &triangles {
+            let c = t.map(|i| positions[i as usize]);
+            for k in 0..3 {
+                assert!(c[k].distance(c[(k + 1) % 3]) <= 1.0 + 1e-12);
+                // Every piece lies in the plane of the original triangle.
+                let n = (soup[0][1] - soup[0][0]).cross(soup[0][2] - soup[0][0]);
+                assert!((c[k] - soup[0][0]).dot(n).abs() < 1e-9);
+            }
+            total += area(c);
+        }
+        assert!((total - area(soup[0])).abs() < 1e-9 * area(soup[0]));
+    }
 }

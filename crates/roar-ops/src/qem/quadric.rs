@@ -1,7 +1,6 @@
 //! Garland–Heckbert quadrics and the one small dense solve behind them.
 
 use glam::DVec3;
-use nalgebra::{Matrix3, Vector3};
 
 /// The error quadric `E(x) = xᵀ A x + 2 bᵀ x + c` of a sum of weighted squared plane distances.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
@@ -55,27 +54,35 @@ impl Quadric {
         (p.dot(ap) + 2.0 * self.b.dot(p) + self.c).max(0.0)
     }
 
-    /// The minimiser of `E`, `x = −A⁻¹ b`, or `None` when A is (near) singular: its smallest
-    /// eigenvalue is below `1e-8` times its largest (flat or cylindrical neighbourhoods).
+    /// The minimiser of `E`, `x = −A⁻¹ b` (closed-form 3×3 solve by cofactors), or `None` when A
+    /// is (near) singular: `det A ≤ 1e-8 · trace(A)³` (flat or cylindrical neighbourhoods).
+    /// A is positive semi-definite, so `det = λ₁λ₂λ₃` and `trace ≥ λ_max`: every matrix whose
+    /// smallest eigenvalue is below `1e-8` times its largest is rejected.
     pub(crate) fn minimizer(&self) -> Option<DVec3> {
         let [xx, xy, xz, yy, yz, zz] = self.a;
-        let m = Matrix3::new(xx, xy, xz, xy, yy, yz, xz, yz, zz);
-        let eig = m.symmetric_eigen();
-        let max = eig.eigenvalues.iter().fold(0.0f64, |m, &l| m.max(l.abs()));
-        if !(max > 0.0 && max.is_finite()) {
+        let trace = xx + yy + zz;
+        if !(trace > 0.0 && trace.is_finite()) {
             return None;
         }
-        if eig.eigenvalues.iter().any(|&l| l.abs() < 1e-8 * max) {
+        // Cofactors of the symmetric matrix (also the adjugate, by symmetry).
+        let c00 = yy * zz - yz * yz;
+        let c01 = xz * yz - xy * zz;
+        let c02 = xy * yz - xz * yy;
+        let c11 = xx * zz - xz * xz;
+        let c12 = xy * xz - xx * yz;
+        let c22 = xx * yy - xy * xy;
+        let det = xx * c00 + xy * c01 + xz * c02;
+        // NaN fails the comparison and is rejected too.
+        let well_conditioned = det > 1e-8 * trace * trace * trace;
+        if !well_conditioned {
             return None;
         }
-        let rhs = Vector3::new(-self.b.x, -self.b.y, -self.b.z);
-        let q = &eig.eigenvectors;
-        let mut y = q.transpose() * rhs;
-        for i in 0..3 {
-            y[i] /= eig.eigenvalues[i];
-        }
-        let x = q * y;
-        let p = DVec3::new(x[0], x[1], x[2]);
+        let r = -self.b;
+        let p = DVec3::new(
+            c00 * r.x + c01 * r.y + c02 * r.z,
+            c01 * r.x + c11 * r.y + c12 * r.z,
+            c02 * r.x + c12 * r.y + c22 * r.z,
+        ) / det;
         p.is_finite().then_some(p)
     }
 }
