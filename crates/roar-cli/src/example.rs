@@ -16,13 +16,17 @@ pub fn chair_soup() -> TriangleSoup {
     let mut soup = Soup::default();
     // Four legs that poke through the seat.
     for (x, z) in [(-0.4, -0.4), (0.4, -0.4), (-0.4, 0.4), (0.4, 0.4)] {
-        soup.add_box(DVec3::new(x - 0.05, 0.0, z - 0.05), DVec3::new(x + 0.05, 0.55, z + 0.05));
+        soup.add_box(
+            DVec3::new(x - 0.05, 0.0, z - 0.05),
+            DVec3::new(x + 0.05, 0.55, z + 0.05),
+        );
     }
     // The seat, with an inward-facing duplicate of every face.
     let seat_start = soup.triangles.len();
     soup.add_box(DVec3::new(-0.5, 0.45, -0.5), DVec3::new(0.5, 0.55, 0.5));
     let seat_faces: Vec<[u32; 3]> = soup.triangles[seat_start..].to_vec();
-    soup.triangles.extend(seat_faces.iter().map(|&[a, b, c]| [a, c, b]));
+    soup.triangles
+        .extend(seat_faces.iter().map(|&[a, b, c]| [a, c, b]));
     // The back rest, overlapping the seat's rear edge.
     soup.add_box(DVec3::new(-0.5, 0.5, 0.4), DVec3::new(0.5, 1.3, 0.5));
     // A zero-thickness armrest: one open, one-sided sheet.
@@ -95,7 +99,12 @@ impl Soup {
         let index = |i: usize, j: usize| base + (j * (n + 1) + i) as u32;
         for j in 0..n {
             for i in 0..n {
-                let (a, b, c, d) = (index(i, j), index(i + 1, j), index(i + 1, j + 1), index(i, j + 1));
+                let (a, b, c, d) = (
+                    index(i, j),
+                    index(i + 1, j),
+                    index(i + 1, j + 1),
+                    index(i, j + 1),
+                );
                 self.triangles.push([a, b, c]);
                 self.triangles.push([a, c, d]);
             }
