@@ -29,10 +29,10 @@ fi
 # The evaluator: `roar eval --json` when the CLI has it, otherwise roar-eval's eval_json example
 # (same library call, same JSON report).
 echo "crosscheck: building the evaluator (release)"
-cargo build --release --quiet -p roar-cli
-if target/release/roar eval --help >/dev/null 2>&1; then
+if cargo build --release --quiet -p roar-cli && target/release/roar eval --help >/dev/null 2>&1; then
   cmd=(target/release/roar eval --json)
 else
+  echo "crosscheck: no working 'roar eval'; using roar-eval's eval_json example instead"
   cargo build --release --quiet -p roar-eval --example eval_json
   cmd=(target/release/examples/eval_json --json)
 fi
