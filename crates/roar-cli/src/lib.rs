@@ -5,3 +5,4 @@
 
 pub mod commands;
 pub mod example;
+pub mod input;

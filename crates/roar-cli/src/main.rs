@@ -21,6 +21,16 @@ enum Command {
     /// Vertex and face counts, bounding box, and whether the mesh is a closed 2-manifold
     /// (its genus and components if so, the first reason it is not otherwise).
     Info(commands::info::InfoArgs),
+    /// Every metric of a mesh (topology, quality, self-intersections, orientation) and, with
+    /// `--ref`, its fidelity to a reference (Chamfer, Hausdorff, normal cosine).
+    Eval(commands::eval::EvalArgs),
+    /// Render flat normal maps of a mesh from the camera rig (what the optimizer sees), with
+    /// `cameras.json` describing every view.
+    Render(commands::render::RenderArgs),
+    /// The watertight, outward-oriented 2-manifold of any soup, decimated to at most N faces.
+    Init(commands::init::InitArgs),
+    /// Guaranteed QEM of a closed 2-manifold to exactly N faces, without new self-intersections.
+    Decimate(commands::decimate::DecimateArgs),
     /// Write the messy chair-like example soup that the README runs on.
     ExampleSoup(commands::example::ExampleArgs),
 }
@@ -29,6 +39,10 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Info(args) => commands::info::run(&args),
+        Command::Eval(args) => commands::eval::run(&args),
+        Command::Render(args) => commands::render::run(&args),
+        Command::Init(args) => commands::init::run(&args),
+        Command::Decimate(args) => commands::decimate::run(&args),
         Command::ExampleSoup(args) => commands::example::run(&args),
     };
     match result {

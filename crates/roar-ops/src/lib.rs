@@ -4,5 +4,15 @@
 //! tangential smoothing, untangle), QEM decimation to an exact face count, and the initial meshes
 //! (watertight init from soups, SDF voxel init).
 
+pub mod block;
+pub mod collapse_block;
+pub mod flips;
+pub mod geometry;
 pub mod init;
 pub mod optim;
+pub mod qem;
+pub mod qslim;
+pub mod select;
+pub mod smoothing;
+pub mod split_block;
+pub mod untangle;

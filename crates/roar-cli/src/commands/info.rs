@@ -33,7 +33,7 @@ pub struct Info {
     pub closed_manifold: bool,
     /// Genus (summed over components), if a closed manifold.
     #[serde(skip_serializing_if = "Option::is_none")]
-    pub genus: Option<i64>,
+    pub genus: Option<usize>,
     /// Connected components, if a closed manifold.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub components: Option<usize>,
@@ -57,7 +57,8 @@ pub fn run(args: &InfoArgs) -> anyhow::Result<()> {
 pub fn info(path: &std::path::Path) -> anyhow::Result<Info> {
     let soup = roar_io::read_mesh(path)?;
     let (welded, _) = soup.welded();
-    let (positions, triangles) = drop_unreferenced(&welded.positions, &welded.triangles);
+    let (positions, triangles) =
+        crate::input::drop_unreferenced(&welded.positions, &welded.triangles);
     let bbox = bounding_box(&positions)
         .with_context(|| format!("{}: no referenced vertices", path.display()))?;
     let mut info = Info {
@@ -106,26 +107,6 @@ fn format_text(path: &std::path::Path, info: &Info) -> String {
         _ => {}
     }
     text
-}
-
-/// Keeps only the vertices some triangle references, renumbering the triangles.
-fn drop_unreferenced(positions: &[DVec3], triangles: &[[u32; 3]]) -> (Vec<DVec3>, Vec<[u32; 3]>) {
-    let mut new_index = vec![u32::MAX; positions.len()];
-    let mut kept = Vec::new();
-    let triangles = triangles
-        .iter()
-        .map(|t| {
-            t.map(|v| {
-                let slot = &mut new_index[v as usize];
-                if *slot == u32::MAX {
-                    *slot = kept.len() as u32;
-                    kept.push(positions[v as usize]);
-                }
-                *slot
-            })
-        })
-        .collect();
-    (kept, triangles)
 }
 
 fn bounding_box(positions: &[DVec3]) -> Option<[[f64; 3]; 2]> {

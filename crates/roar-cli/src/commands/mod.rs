@@ -1,5 +1,9 @@
 //! One module per `roar` subcommand: a clap `Args` struct and a `run` function returning
 //! `anyhow::Result<()>`, so the binary only dispatches and prints errors.
 
+pub mod decimate;
+pub mod eval;
 pub mod example;
 pub mod info;
+pub mod init;
+pub mod render;

@@ -1,0 +1,133 @@
+//! Remeshing blocks on a ~10k-face sphere: Face Collapse + flips on a jittered (folded) copy,
+//! Face Split under and at budget against the analytic sphere projector (O(1) per sample, so
+//! the figure is the block's own cost), tangential smoothing. Goal: < 20 ms per block call.
+
+use criterion::{BatchSize, Criterion, criterion_main};
+use roar_mesh::shapes::perturbed;
+use roar_mesh::spatial::SphereProjector;
+use roar_mesh::{DVec3, Mesh};
+use roar_ops::collapse_block::{FaceCollapseOptions, face_collapse};
+use roar_ops::optim::{Optimizer, OptimizerOptions};
+use roar_ops::smoothing::{SmoothingOptions, tangential_smoothing};
+use roar_ops::split_block::{FaceSplitOptions, SplitThreshold, face_split};
+use std::hint::black_box;
+
+/// Latitude–longitude unit sphere: `2·lon·(lat − 1)` faces (50 × 100 → 9800).
+fn uv_sphere(lat: usize, lon: usize) -> Mesh {
+    let mut positions = vec![DVec3::Z];
+    for i in 1..lat {
+        let theta = std::f64::consts::PI * i as f64 / lat as f64;
+        for j in 0..lon {
+            let phi = std::f64::consts::TAU * j as f64 / lon as f64;
+            positions.push(DVec3::new(
+                theta.sin() * phi.cos(),
+                theta.sin() * phi.sin(),
+                theta.cos(),
+            ));
+        }
+    }
+    positions.push(-DVec3::Z);
+    let south = (positions.len() - 1) as u32;
+    let ring = |i: usize, j: usize| (1 + (i - 1) * lon + j % lon) as u32;
+    let mut tris = Vec::new();
+    for j in 0..lon {
+        tris.push([0, ring(1, j), ring(1, j + 1)]);
+        tris.push([south, ring(lat - 1, j + 1), ring(lat - 1, j)]);
+    }
+    for i in 1..lat - 1 {
+        for j in 0..lon {
+            let (a, b, c, d) = (
+                ring(i, j),
+                ring(i + 1, j),
+                ring(i + 1, j + 1),
+                ring(i, j + 1),
+            );
+            tris.push([a, b, c]);
+            tris.push([a, c, d]);
+        }
+    }
+    Mesh::from_triangles(positions, &tris).expect("uv sphere is a closed manifold")
+}
+
+fn blocks(c: &mut Criterion) {
+    let base = uv_sphere(50, 100);
+    let folded = perturbed(&base, 0.02, 1);
+    let smooth = perturbed(&base, 0.002, 2);
+    let optimizer =
+        |m: &Mesh| Optimizer::new(m.vertex_capacity(), OptimizerOptions::default()).unwrap();
+    let sphere = SphereProjector {
+        center: DVec3::ZERO,
+        radius: 1.0,
+    };
+    let split_options = FaceSplitOptions {
+        threshold: SplitThreshold::PerFace(0.02),
+        ..FaceSplitOptions::default()
+    };
+    let f = base.n_faces();
+
+    let mut group = c.benchmark_group("blocks_10k_faces");
+    group.sample_size(20);
+    group.bench_function("face_collapse_and_flips", |b| {
+        b.iter_batched(
+            || (folded.clone(), optimizer(&folded)),
+            |(mut m, mut o)| {
+                black_box(face_collapse(
+                    &mut m,
+                    &mut o,
+                    &FaceCollapseOptions::default(),
+                ))
+            },
+            BatchSize::LargeInput,
+        )
+    });
+    group.bench_function("face_split_under_budget", |b| {
+        b.iter_batched(
+            || (smooth.clone(), optimizer(&smooth)),
+            |(mut m, mut o)| {
+                black_box(face_split(
+                    &mut m,
+                    &mut o,
+                    &sphere,
+                    f + 2000,
+                    &split_options,
+                ))
+            },
+            BatchSize::LargeInput,
+        )
+    });
+    group.bench_function("face_split_at_budget", |b| {
+        b.iter_batched(
+            || (smooth.clone(), optimizer(&smooth)),
+            |(mut m, mut o)| black_box(face_split(&mut m, &mut o, &sphere, f, &split_options)),
+            BatchSize::LargeInput,
+        )
+    });
+    group.bench_function("tangential_smoothing", |b| {
+        b.iter_batched(
+            || smooth.clone(),
+            |mut m| black_box(tangential_smoothing(&mut m, &SmoothingOptions::default())),
+            BatchSize::LargeInput,
+        )
+    });
+    group.finish();
+
+    // One-off stats so the figures can be read against the work done.
+    let (mut m, mut o) = (folded.clone(), optimizer(&folded));
+    eprintln!(
+        "face_collapse: {:?}",
+        face_collapse(&mut m, &mut o, &FaceCollapseOptions::default())
+    );
+    let (mut m, mut o) = (smooth.clone(), optimizer(&smooth));
+    eprintln!(
+        "face_split under budget: {:?}",
+        face_split(&mut m, &mut o, &sphere, f + 2000, &split_options)
+    );
+}
+
+mod group {
+    //! The criterion group (its macro generates an undocumented `pub fn`).
+    #![allow(missing_docs)]
+    criterion::criterion_group!(benches, super::blocks);
+}
+use group::benches;
+criterion_main!(benches);

@@ -1,0 +1,162 @@
+//! The Face Collapse block: self-intersection attenuation by collapsing folded faces (spec §3.6
+//! as amended by Verification note 4), followed by the edge flips of §3.7.
+//!
+//! 1. Flag face f when `n_f · (n_v0 + n_v1 + n_v2) < slack` (unit vertex normals, slack 0.6).
+//!    Optional gate (off): skip faces whose `|n_o(f)| = |Σ n_vk| / 3` is below 0.98.
+//! 2. Candidate edges: the edges of flagged faces, priority `exp(−|e|)`.
+//! 3. Validity: the QSlim collapse simulation ([`crate::qslim::edge_cost`]); no incident face may
+//!    flip, and optionally (off for fold removal) no resulting face may have `Q > 5`. An edge
+//!    with no valid placement drops out; otherwise the placement with lower QSlim cost decides
+//!    which endpoint survives.
+//! 4. Independent selection (§3.11), collapse (the survivor keeps the chosen endpoint's position
+//!    and optimizer row), compact, then flips.
+
+use crate::block::{Block, BlockContext, BlockStats, compact_with_optimizer, sync_optimizer_len};
+use crate::flips::{FlipOptions, flip_edges};
+use crate::geometry::Geometry;
+use crate::optim::Optimizer;
+use crate::qslim::{EdgeCost, QSlimOptions, ValidityOptions, edge_cost, vertex_quadrics};
+use crate::select::{SelectOptions, select_independent_edges};
+use roar_mesh::Mesh;
+
+/// Options of [`face_collapse`] (spec §3.6, note 4).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FaceCollapseOptions {
+    /// A face is flagged when `n_f · Σ_k n_{v_k} < fold_slack`. Default 0.6 (note 4: the
+    /// supplementary's slack added to the code's 0).
+    pub fold_slack: f64,
+    /// Off-by-default gate: do not collapse flagged faces whose vertex-derived normal
+    /// `|n_o(f)|` is below this ("normal size 0.98", note 4). `None` = off.
+    pub min_normal_size: Option<f64>,
+    /// Collapse validity; default: flip test only, `max_quality: None` (note 4: the Q ≤ 5 check
+    /// is off for fold removal).
+    pub validity: ValidityOptions,
+    /// QSlim weights and vertex-plane variant used to choose the placement (§3.10).
+    pub qslim: QSlimOptions,
+    /// Independent selection (§3.11).
+    pub select: SelectOptions,
+    /// Edge flips run after the collapses (§3.6 step 7); `None` skips them.
+    pub flips: Option<FlipOptions>,
+}
+
+impl Default for FaceCollapseOptions {
+    fn default() -> Self {
+        Self {
+            fold_slack: 0.6,
+            min_normal_size: None,
+            validity: ValidityOptions::default(),
+            qslim: QSlimOptions::default(),
+            select: SelectOptions::default(),
+            flips: Some(FlipOptions::default()),
+        }
+    }
+}
+
+/// Faces flagged by the fold estimator of §3.6 step 1 (note 4), by face slot.
+pub fn flagged_faces(mesh: &Mesh, geometry: &Geometry, options: &FaceCollapseOptions) -> Vec<bool> {
+    let mut flags = vec![false; mesh.face_capacity()];
+    for f in mesh.faces() {
+        let s = geometry.vertex_normal_sum(mesh, f);
+        let mut flag = geometry.face_normals[f.index()].dot(s) < options.fold_slack;
+        if let Some(min) = options.min_normal_size {
+            flag &= s.length() / 3.0 >= min;
+        }
+        flags[f.index()] = flag;
+    }
+    flags
+}
+
+/// Runs the Face Collapse block (spec §3.6, note 4) and then the flips; compacts the mesh and
+/// the optimizer rows if anything collapsed.
+///
+/// Stats: `candidates` = candidate edges (edges of flagged faces); `accepted` = collapses;
+/// `rejected`: `"flip"` / `"quality"` (no valid placement), `"link"` (local maximum refused by
+/// the link condition), `"not_selected"` (valid but lost the independent selection);
+/// `counters["flagged_faces"]`; `sub` = the flip stats.
+pub fn face_collapse(
+    mesh: &mut Mesh,
+    optimizer: &mut Optimizer,
+    options: &FaceCollapseOptions,
+) -> BlockStats {
+    let mut stats = BlockStats::new("face_collapse");
+    sync_optimizer_len(mesh, optimizer);
+    let geometry = Geometry::compute(mesh);
+    let flags = flagged_faces(mesh, &geometry, options);
+    stats.count("flagged_faces", flags.iter().filter(|&&f| f).count());
+
+    let mut is_candidate = vec![false; mesh.edge_capacity()];
+    for f in mesh.faces() {
+        if flags[f.index()] {
+            for h in mesh.face_halfedges(f) {
+                is_candidate[h.edge().index()] = true;
+            }
+        }
+    }
+    let mut priority = vec![0.0; mesh.edge_capacity()];
+    let mut placement: Vec<Option<EdgeCost>> = vec![None; mesh.edge_capacity()];
+    if is_candidate.iter().any(|&c| c) {
+        let quadrics = vertex_quadrics(mesh, &geometry, &options.qslim);
+        for e in mesh.edges() {
+            if !is_candidate[e.index()] {
+                continue;
+            }
+            stats.candidates += 1;
+            match edge_cost(mesh, &quadrics, e, &options.validity) {
+                Ok(c) => {
+                    priority[e.index()] = (-mesh.edge_length(e)).exp();
+                    placement[e.index()] = Some(c);
+                }
+                Err(why) => stats.reject(why.reason(), 1),
+            }
+        }
+    }
+    let selection = select_independent_edges(mesh, &priority, &options.select);
+    stats.reject("link", selection.link_rejected);
+    let valid = placement.iter().filter(|p| p.is_some()).count();
+    for &e in &selection.edges {
+        let c =
+            placement[e.index()].expect("selected edges have positive priority, so a placement");
+        match mesh.collapse(c.halfedge) {
+            Ok(out) => {
+                optimizer
+                    .on_collapse(out.survivor.raw(), c.keep.raw())
+                    .expect("optimizer rows cover every vertex slot (invariant)");
+                stats.accepted += 1;
+            }
+            Err(_) => stats.reject("link", 1),
+        }
+    }
+    stats.reject(
+        "not_selected",
+        valid.saturating_sub(selection.edges.len() + selection.link_rejected),
+    );
+    if stats.accepted > 0 {
+        compact_with_optimizer(mesh, optimizer);
+    }
+    if let Some(flip_options) = &options.flips {
+        stats.sub.push(flip_edges(mesh, flip_options));
+    }
+    stats
+}
+
+/// [`Block`] wrapper of [`face_collapse`] (collapses plus flips).
+#[derive(Debug, Clone, Default)]
+pub struct FaceCollapse {
+    /// Options passed to [`face_collapse`].
+    pub options: FaceCollapseOptions,
+}
+
+impl Block for FaceCollapse {
+    fn name(&self) -> &'static str {
+        "face_collapse"
+    }
+
+    fn apply(
+        &mut self,
+        mesh: &mut Mesh,
+        optimizer: &mut Optimizer,
+        _ctx: &BlockContext,
+    ) -> BlockStats {
+        face_collapse(mesh, optimizer, &self.options)
+    }
+}

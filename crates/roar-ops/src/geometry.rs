@@ -1,0 +1,175 @@
+//! Per-block geometry snapshots on the half-edge mesh (spec §2.2): face normals and areas, ROAR
+//! vertex normals (area × corner-angle weights), the normal magnitude μ_v, face folds φ_f and
+//! triangle quality Q. Computed once per block call into `Vec`s indexed by element id (slot),
+//! dead slots hold zeros.
+
+use roar_mesh::{DEGENERATE_CROSS, DEGENERATE_NORMAL, DVec3, Mesh, VertexId};
+
+/// Unit normal of triangle `(a, b, c)` with the spec's degenerate rule: `|cross| ≤ 1e-9` gives
+/// `(1, 0, 0)` (spec §2.2).
+pub fn triangle_normal(a: DVec3, b: DVec3, c: DVec3) -> DVec3 {
+    let n = (b - a).cross(c - a);
+    let len = n.length();
+    if len > DEGENERATE_CROSS && len.is_finite() {
+        n / len
+    } else {
+        DEGENERATE_NORMAL
+    }
+}
+
+/// Interior angles of triangle `p` at its three corners, from the clipped cosine (spec §2.2).
+/// A corner with a zero-length side gets π/2 (its cosine is taken as 0).
+pub fn corner_angles(p: [DVec3; 3]) -> [f64; 3] {
+    std::array::from_fn(|k| {
+        let u = (p[(k + 1) % 3] - p[k]).normalize_or_zero();
+        let v = (p[(k + 2) % 3] - p[k]).normalize_or_zero();
+        u.dot(v).clamp(-1.0, 1.0).acos()
+    })
+}
+
+/// Triangle quality `Q = abc / (8 (s−a)(s−b)(s−c))` (spec §2.2): 1 for an equilateral
+/// triangle, growing without bound for slivers (+∞ for a collinear triangle with non-zero
+/// sides). A fully collapsed triangle (0/0) returns NaN; callers decide (collapse simulation
+/// counts NaN as 1).
+pub fn triangle_quality(p: [DVec3; 3]) -> f64 {
+    let a = p[1].distance(p[2]);
+    let b = p[2].distance(p[0]);
+    let c = p[0].distance(p[1]);
+    let s = 0.5 * (a + b + c);
+    let den = 8.0 * (s - a) * (s - b) * (s - c);
+    let num = a * b * c;
+    if den <= 0.0 {
+        if num > 0.0 { f64::INFINITY } else { f64::NAN }
+    } else {
+        num / den
+    }
+}
+
+/// Geometry of one mesh state, indexed by slot id (spec §2.2).
+#[derive(Debug, Clone, Default)]
+pub struct Geometry {
+    /// Unit face normals (degenerate faces: `(1, 0, 0)`), by face slot.
+    pub face_normals: Vec<DVec3>,
+    /// Face areas clamped below at 1e-9, by face slot.
+    pub face_areas: Vec<f64>,
+    /// Unnormalized ROAR vertex normal `N_v = Σ_f A_f θ_{f,v} n_f`, by vertex slot.
+    pub vertex_normals_raw: Vec<DVec3>,
+    /// Unit vertex normal `N_v / |N_v|` (zero if `N_v` vanishes), by vertex slot.
+    pub vertex_normals: Vec<DVec3>,
+    /// Normal magnitude `μ_v = |N_v| / Σ_f A_f θ_{f,v}` ∈ [0, 1], by vertex slot.
+    pub normal_magnitude: Vec<f64>,
+}
+
+impl Geometry {
+    /// Computes all quantities in one pass over the faces, O(F).
+    pub fn compute(mesh: &Mesh) -> Self {
+        let nf = mesh.face_capacity();
+        let nv = mesh.vertex_capacity();
+        let mut g = Geometry {
+            face_normals: vec![DVec3::ZERO; nf],
+            face_areas: vec![0.0; nf],
+            vertex_normals_raw: vec![DVec3::ZERO; nv],
+            vertex_normals: vec![DVec3::ZERO; nv],
+            normal_magnitude: vec![0.0; nv],
+        };
+        let mut weight_sum = vec![0.0; nv];
+        for f in mesh.faces() {
+            let vs = mesh.face_vertices(f);
+            let p = vs.map(|v| mesh.position(v));
+            let n = triangle_normal(p[0], p[1], p[2]);
+            let area = (0.5 * (p[1] - p[0]).cross(p[2] - p[0]).length()).max(DEGENERATE_CROSS);
+            g.face_normals[f.index()] = n;
+            g.face_areas[f.index()] = area;
+            let angles = corner_angles(p);
+            for k in 0..3 {
+                let w = area * angles[k];
+                g.vertex_normals_raw[vs[k].index()] += w * n;
+                weight_sum[vs[k].index()] += w;
+            }
+        }
+        for v in mesh.vertices() {
+            let i = v.index();
+            let raw = g.vertex_normals_raw[i];
+            g.vertex_normals[i] = raw.normalize_or_zero();
+            g.normal_magnitude[i] = if weight_sum[i] > 0.0 {
+                (raw.length() / weight_sum[i]).min(1.0)
+            } else {
+                0.0
+            };
+        }
+        g
+    }
+
+    /// Unit normal of vertex `v`.
+    pub fn vertex_normal(&self, v: VertexId) -> DVec3 {
+        self.vertex_normals[v.index()]
+    }
+
+    /// Face folds `φ_f = 1 − (1/3) Σ_k n_f · n_{v_k}` by face slot (spec §2.2): 0 on smooth
+    /// surfaces, above 1 when a face points against its own vertex normals.
+    pub fn face_folds(&self, mesh: &Mesh) -> Vec<f64> {
+        let mut folds = vec![0.0; mesh.face_capacity()];
+        for f in mesh.faces() {
+            folds[f.index()] = 1.0
+                - self
+                    .vertex_normal_sum(mesh, f)
+                    .dot(self.face_normals[f.index()])
+                    / 3.0;
+        }
+        folds
+    }
+
+    /// `Σ_k n_{v_k}` over the three corners of face `f` (unit vertex normals).
+    pub fn vertex_normal_sum(&self, mesh: &Mesh, f: roar_mesh::FaceId) -> DVec3 {
+        mesh.face_vertices(f)
+            .iter()
+            .map(|&v| self.vertex_normals[v.index()])
+            .sum()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use roar_mesh::shapes::icosphere;
+
+    #[test]
+    fn quality_of_equilateral_is_one_and_slivers_grow() {
+        let eq = [
+            DVec3::ZERO,
+            DVec3::X,
+            DVec3::new(0.5, 3f64.sqrt() / 2.0, 0.0),
+        ];
+        assert!((triangle_quality(eq) - 1.0).abs() < 1e-12);
+        let sliver = [DVec3::ZERO, DVec3::X, DVec3::new(0.5, 0.01, 0.0)];
+        assert!(triangle_quality(sliver) > 10.0);
+        let line = [DVec3::ZERO, DVec3::X, DVec3::new(2.0, 0.0, 0.0)];
+        assert_eq!(triangle_quality(line), f64::INFINITY);
+        assert!(triangle_quality([DVec3::ONE; 3]).is_nan());
+    }
+
+    #[test]
+    fn sphere_normals_point_outward_with_unit_magnitude() {
+        let mesh = icosphere(2);
+        let g = Geometry::compute(&mesh);
+        for v in mesh.vertices() {
+            let p = mesh.position(v);
+            assert!(g.vertex_normal(v).dot(p.normalize()) > 0.99);
+            let mu = g.normal_magnitude[v.index()];
+            assert!(mu > 0.97 && mu <= 1.0, "μ = {mu}");
+        }
+        let folds = g.face_folds(&mesh);
+        assert!(mesh.faces().all(|f| folds[f.index()].abs() < 0.02));
+    }
+
+    #[test]
+    fn angles_sum_to_pi() {
+        let p = [
+            DVec3::ZERO,
+            DVec3::new(2.0, 0.1, 0.0),
+            DVec3::new(0.3, 1.0, 0.5),
+        ];
+        let a = corner_angles(p);
+        assert!((a.iter().sum::<f64>() - std::f64::consts::PI).abs() < 1e-12);
+    }
+}

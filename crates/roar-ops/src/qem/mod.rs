@@ -1,0 +1,662 @@
+//! QEM decimation to an exact face count (Garland–Heckbert quadric edge collapse), keeping the
+//! mesh a closed, oriented 2-manifold free of new self-intersections.
+//!
+//! The pipeline uses it twice (DESIGN.md §2, spec §3 "working budget" and §6): to bring the
+//! initial mesh to the working budget, and to reach exactly the requested face count N at the
+//! end without introducing self-intersections.
+//!
+//! Algorithm: every live vertex gets the sum of the area-weighted plane quadrics of its faces;
+//! every edge gets the cost of merging its endpoints at the quadric's minimiser (or the best of
+//! the endpoints and the midpoint when the 3×3 system is singular). Edges are popped cheapest
+//! first from a heap with lazy invalidation (per-edge version stamps). A popped collapse must pass
+//! the topological check of [`Mesh::can_collapse`] (link condition, no tetrahedron collapse) and
+//! the geometric vetoes, each counted in [`VetoCounts`]:
+//! - **normal flip**: the normal of a face around the merged vertex turns by `n·n' ≤
+//!   min_normal_dot`, or a new face is near-degenerate;
+//! - **quality**: a new face's aspect ratio `Q = R/(2r)` exceeds the current bound and the worst
+//!   of the replaced faces;
+//! - **self-intersection**: a new face intersects another face (exact test
+//!   [`faces_intersect`] against the faces a dynamic grid finds near it).
+//!
+//! When the heap runs dry above the target, the edges are re-queued (vetoes are local, so
+//! collapses elsewhere may have unblocked them) and, when a whole pass makes no progress, the
+//! quality bound is relaxed stepwise (`quality_bounds`, 5 → 10 → 20). The manifold,
+//! orientation and intersection vetoes are never relaxed.
+
+mod grid;
+mod quadric;
+
+use glam::DVec3;
+use grid::FaceGrid;
+use quadric::{Quadric, placement};
+use roar_mesh::spatial::{Aabb, faces_intersect};
+use roar_mesh::{Collapse, EdgeId, FaceId, HalfedgeId, Mesh, Remap, VertexId};
+use std::cmp::Ordering;
+use std::collections::BinaryHeap;
+use std::fmt;
+
+/// Options of [`decimate`]. `Default` gives the values used by the pipeline.
+#[derive(Debug, Clone, PartialEq)]
+pub struct DecimateOptions {
+    /// A collapse is vetoed if some face around the merged vertex has `n_before · n_after ≤
+    /// min_normal_dot` (unit normals). Default 0.2 (a face may turn by up to ~78°). Must lie in
+    /// [-1, 1).
+    pub min_normal_dot: f64,
+    /// Successive bounds on the aspect ratio `Q = R/(2r)` (1 for an equilateral triangle) of the
+    /// faces a collapse creates; the next bound is used only when the previous one blocks the
+    /// budget. Default `[5, 10, 20]` (the brief of the pipeline's final QEM). Each must be ≥ 1.
+    pub quality_bounds: Vec<f64>,
+    /// Run the self-intersection veto (default `true`). Switching it off makes decimation
+    /// faster but may create intersections.
+    pub check_self_intersections: bool,
+    /// Re-queue all edges at most this many times per quality bound (default 8).
+    pub max_passes_per_bound: usize,
+    /// When the budget cannot be reached: `false` (default) returns
+    /// [`DecimateError::BudgetNotReached`]; `true` keeps the closest mesh and returns `Ok` with
+    /// [`DecimateStats::reached_target`] false.
+    pub best_effort: bool,
+}
+
+impl Default for DecimateOptions {
+    fn default() -> Self {
+        Self {
+            min_normal_dot: 0.2,
+            quality_bounds: vec![5.0, 10.0, 20.0],
+            check_self_intersections: true,
+            max_passes_per_bound: 8,
+            best_effort: false,
+        }
+    }
+}
+
+/// How many popped collapses each check rejected.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct VetoCounts {
+    /// [`Mesh::can_collapse`] refused (link condition, valence 3, tetrahedron).
+    pub topology: usize,
+    /// A face normal would turn past `min_normal_dot`.
+    pub normal_flip: usize,
+    /// A new face would be near-degenerate (|cross| ≤ 1e-10 · longest edge²).
+    pub degenerate: usize,
+    /// A new face would exceed the current quality bound.
+    pub quality: usize,
+    /// A new face would intersect another face.
+    pub self_intersection: usize,
+}
+
+impl VetoCounts {
+    /// Total number of vetoes.
+    pub fn total(&self) -> usize {
+        self.topology + self.normal_flip + self.degenerate + self.quality + self.self_intersection
+    }
+
+    fn add(&mut self, o: &VetoCounts) {
+        self.topology += o.topology;
+        self.normal_flip += o.normal_flip;
+        self.degenerate += o.degenerate;
+        self.quality += o.quality;
+        self.self_intersection += o.self_intersection;
+    }
+}
+
+impl fmt::Display for VetoCounts {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(
+            f,
+            "topology {}, normal flip {}, degenerate {}, quality {}, self-intersection {}",
+            self.topology, self.normal_flip, self.degenerate, self.quality, self.self_intersection
+        )
+    }
+}
+
+/// Outcome of [`decimate`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct DecimateStats {
+    /// Face count before.
+    pub initial_faces: usize,
+    /// Face count after.
+    pub final_faces: usize,
+    /// The requested face count.
+    pub target: usize,
+    /// Whether `final_faces == target` (always true unless `best_effort` kept a closer mesh, or
+    /// the target was at or above the initial count, see `noop`).
+    pub reached_target: bool,
+    /// The target was ≥ the initial face count: nothing was done (decimation never adds faces).
+    pub noop: bool,
+    /// Collapses applied.
+    pub collapses: usize,
+    /// Vetoes by reason over the whole run.
+    pub vetoes: VetoCounts,
+    /// The quality bound in force when the run ended (`None` for a no-op).
+    pub quality_bound: Option<f64>,
+    /// Heap passes run (each re-queues every live edge).
+    pub passes: usize,
+    /// Largest quadric error of an applied collapse (squared distance × area units).
+    pub max_cost: f64,
+    /// The compaction done at the end (old → new ids); `None` for a no-op. Per-vertex caller
+    /// data kept in step by the collapse callback must be permuted with it.
+    pub remap: Option<Remap>,
+}
+
+/// Errors of [`decimate`]. On error the mesh is unchanged, except for `BudgetNotReached`, which
+/// leaves the closest mesh reached (compacted).
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum DecimateError {
+    /// A closed triangle mesh always has an even face count (3F = 2E).
+    #[error(
+        "face budget {target} is odd: a closed triangle mesh has an even face count; use {below} or {above}"
+    )]
+    OddTarget {
+        /// The requested count.
+        target: usize,
+        /// Nearest even count below.
+        below: usize,
+        /// Nearest even count above.
+        above: usize,
+    },
+    /// The target is below what the components and their genera allow.
+    #[error(
+        "face budget {target} is impossible: {components} component(s) of total genus {genus} need at least {minimum} faces"
+    )]
+    TargetBelowMinimum {
+        /// The requested count.
+        target: usize,
+        /// Smallest face count a closed mesh with these components and genera can have.
+        minimum: usize,
+        /// Connected components.
+        components: usize,
+        /// Total genus.
+        genus: usize,
+    },
+    /// The vetoes blocked every remaining collapse above the target.
+    #[error(
+        "could not decimate to {target} faces: stopped at {reached} ({} too many); last pass blocked by {reasons}",
+        reached - target
+    )]
+    BudgetNotReached {
+        /// The requested count.
+        target: usize,
+        /// The face count reached (the mesh is left there).
+        reached: usize,
+        /// Vetoes of the last pass: why the remaining collapses were refused.
+        reasons: VetoCounts,
+    },
+    /// An option is out of range.
+    #[error("invalid decimation option {name}: {reason}")]
+    InvalidOption {
+        /// Field name.
+        name: &'static str,
+        /// What is expected.
+        reason: &'static str,
+    },
+}
+
+/// Smallest face count of a closed orientable triangulated surface of genus `g`: `2(V − 2 + 2g)`
+/// with the minimal vertex count `V` (Heawood's bound `⌈(7 + √(1 + 48g))/2⌉`, 10 for genus 2,
+/// 4 for the sphere).
+pub fn minimum_faces_for_genus(g: usize) -> usize {
+    let v = match g {
+        0 => 4,
+        2 => 10,
+        _ => ((7.0 + (1.0 + 48.0 * g as f64).sqrt()) / 2.0 - 1e-9).ceil() as usize,
+    };
+    2 * (v - 2 + 2 * g)
+}
+
+/// Smallest face count `mesh` can be decimated to without changing its components or genera
+/// (the sum of [`minimum_faces_for_genus`] over components). Greedy collapse may stop above it.
+pub fn minimum_faces(mesh: &Mesh) -> usize {
+    mesh.component_genera()
+        .into_iter()
+        .map(minimum_faces_for_genus)
+        .sum()
+}
+
+/// Decimates `mesh` to exactly `target_faces` faces; see the module docs and
+/// [`decimate_with`] (this is it without a collapse callback).
+pub fn decimate(
+    mesh: &mut Mesh,
+    target_faces: usize,
+    options: &DecimateOptions,
+) -> Result<DecimateStats, DecimateError> {
+    decimate_with(mesh, target_faces, options, |_| {})
+}
+
+/// Decimates `mesh` to exactly `target_faces` faces, calling `on_collapse` after every applied
+/// collapse (before the final compaction), so callers can keep per-vertex data in step: the
+/// survivor `head(h)` keeps its id (and, for the optimizer, its row: `Optimizer::on_collapse`
+/// is not needed); it is moved to the quadric placement. At the end the mesh is compacted and
+/// the [`Remap`] returned in the stats.
+///
+/// Promises: the mesh stays valid (closed, oriented, 2-manifold), components and genera are
+/// unchanged, no collapse creates a self-intersection (with `check_self_intersections`), and
+/// `n_faces() == target_faces` on `Ok` unless `best_effort` or `noop` say otherwise.
+///
+/// Errors: [`DecimateError::OddTarget`], [`DecimateError::TargetBelowMinimum`] (checked up
+/// front, mesh unchanged), [`DecimateError::BudgetNotReached`] (mesh left at the closest count,
+/// compacted), [`DecimateError::InvalidOption`]. A target at or above the current count is a
+/// no-op (`stats.noop`).
+pub fn decimate_with(
+    mesh: &mut Mesh,
+    target_faces: usize,
+    options: &DecimateOptions,
+    on_collapse: impl FnMut(&Collapse),
+) -> Result<DecimateStats, DecimateError> {
+    check_options(options)?;
+    if target_faces % 2 == 1 {
+        return Err(DecimateError::OddTarget {
+            target: target_faces,
+            below: target_faces - 1,
+            above: target_faces + 1,
+        });
+    }
+    let initial = mesh.n_faces();
+    if target_faces >= initial {
+        return Ok(DecimateStats {
+            initial_faces: initial,
+            final_faces: initial,
+            target: target_faces,
+            reached_target: target_faces == initial,
+            noop: true,
+            collapses: 0,
+            vetoes: VetoCounts::default(),
+            quality_bound: None,
+            passes: 0,
+            max_cost: 0.0,
+            remap: None,
+        });
+    }
+    let minimum = minimum_faces(mesh);
+    if target_faces < minimum {
+        return Err(DecimateError::TargetBelowMinimum {
+            target: target_faces,
+            minimum,
+            components: mesh.components().0,
+            genus: mesh.genus(),
+        });
+    }
+
+    let mut run = Decimator::new(mesh, options, on_collapse);
+    let mut last_pass = VetoCounts::default();
+    let mut bound_used = options.quality_bounds[0];
+    'bounds: for &bound in &options.quality_bounds {
+        bound_used = bound;
+        for _ in 0..options.max_passes_per_bound {
+            let before = run.mesh.n_faces();
+            last_pass = run.pass(target_faces, bound);
+            if run.mesh.n_faces() <= target_faces {
+                break 'bounds;
+            }
+            if run.mesh.n_faces() == before {
+                break;
+            }
+        }
+    }
+    let stats_core = (run.collapses, run.vetoes, run.passes, run.max_cost);
+    drop(run);
+    let remap = mesh.compact();
+    let final_faces = mesh.n_faces();
+    let reached = final_faces == target_faces;
+    if !reached && !options.best_effort {
+        return Err(DecimateError::BudgetNotReached {
+            target: target_faces,
+            reached: final_faces,
+            reasons: last_pass,
+        });
+    }
+    Ok(DecimateStats {
+        initial_faces: initial,
+        final_faces,
+        target: target_faces,
+        reached_target: reached,
+        noop: false,
+        collapses: stats_core.0,
+        vetoes: stats_core.1,
+        quality_bound: Some(bound_used),
+        passes: stats_core.2,
+        max_cost: stats_core.3,
+        remap: Some(remap),
+    })
+}
+
+fn check_options(o: &DecimateOptions) -> Result<(), DecimateError> {
+    let bad = |name, reason| Err(DecimateError::InvalidOption { name, reason });
+    if !(-1.0..1.0).contains(&o.min_normal_dot) {
+        return bad("min_normal_dot", "a value in [-1, 1)");
+    }
+    if o.quality_bounds.is_empty() || o.quality_bounds.iter().any(|&q| q.is_nan() || q < 1.0) {
+        return bad("quality_bounds", "a non-empty list of values >= 1");
+    }
+    if o.max_passes_per_bound == 0 {
+        return bad("max_passes_per_bound", "at least 1");
+    }
+    Ok(())
+}
+
+/// A queued collapse of `edge` to `target` with quadric error `cost`, valid while the edge's
+/// version stamp equals `version`.
+#[derive(Debug, Clone, Copy)]
+struct Entry {
+    cost: f64,
+    edge: u32,
+    version: u32,
+    target: DVec3,
+}
+
+impl PartialEq for Entry {
+    fn eq(&self, o: &Self) -> bool {
+        self.cmp(o) == Ordering::Equal
+    }
+}
+impl Eq for Entry {}
+impl PartialOrd for Entry {
+    fn partial_cmp(&self, o: &Self) -> Option<Ordering> {
+        Some(self.cmp(o))
+    }
+}
+impl Ord for Entry {
+    /// Reversed, so the std max-heap pops the cheapest (ties: lowest edge id, deterministic).
+    fn cmp(&self, o: &Self) -> Ordering {
+        o.cost
+            .total_cmp(&self.cost)
+            .then_with(|| o.edge.cmp(&self.edge))
+    }
+}
+
+/// Why a collapse was refused.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Veto {
+    NormalFlip,
+    Degenerate,
+    Quality,
+    SelfIntersection,
+}
+
+/// Aspect ratio `Q = R/(2r) = abc·s/(8K²)` (1 for equilateral, ∞ for degenerate).
+pub fn triangle_quality([p0, p1, p2]: [DVec3; 3]) -> f64 {
+    let (a, b, c) = (p1.distance(p2), p2.distance(p0), p0.distance(p1));
+    let k = 0.5 * (p1 - p0).cross(p2 - p0).length();
+    if k <= 0.0 {
+        return f64::INFINITY;
+    }
+    a * b * c * (0.5 * (a + b + c)) / (8.0 * k * k)
+}
+
+struct Decimator<'m, F: FnMut(&Collapse)> {
+    mesh: &'m mut Mesh,
+    options: &'m DecimateOptions,
+    on_collapse: F,
+    quadrics: Vec<Quadric>,
+    versions: Vec<u32>,
+    heap: BinaryHeap<Entry>,
+    grid: Option<FaceGrid>,
+    grid_faces: usize,
+    collapses: usize,
+    vetoes: VetoCounts,
+    passes: usize,
+    max_cost: f64,
+}
+
+fn face_box(mesh: &Mesh, f: FaceId) -> Aabb {
+    Aabb::from_triangle(mesh.face_vertices(f).map(|v| mesh.position(v)))
+}
+
+impl<'m, F: FnMut(&Collapse)> Decimator<'m, F> {
+    fn new(mesh: &'m mut Mesh, options: &'m DecimateOptions, on_collapse: F) -> Self {
+        let mut quadrics = vec![Quadric::default(); mesh.vertex_capacity()];
+        for f in mesh.faces() {
+            let cross = mesh.face_cross(f);
+            let len = cross.length();
+            if !(len > 0.0 && len.is_finite()) {
+                continue;
+            }
+            let q = Quadric::from_plane(cross / len, mesh.face_centroid(f), 0.5 * len);
+            for v in mesh.face_vertices(f) {
+                quadrics[v.index()] = quadrics[v.index()].add(&q);
+            }
+        }
+        let mut d = Decimator {
+            versions: vec![0; mesh.edge_capacity()],
+            mesh,
+            options,
+            on_collapse,
+            quadrics,
+            heap: BinaryHeap::new(),
+            grid: None,
+            grid_faces: 0,
+            collapses: 0,
+            vetoes: VetoCounts::default(),
+            passes: 0,
+            max_cost: 0.0,
+        };
+        if options.check_self_intersections {
+            d.rebuild_grid();
+        }
+        d
+    }
+
+    /// Rebuilds the face grid with cells of twice the current mean edge length.
+    fn rebuild_grid(&mut self) {
+        let mesh = &*self.mesh;
+        let (sum, n) = mesh
+            .edges()
+            .fold((0.0, 0usize), |(s, n), e| (s + mesh.edge_length(e), n + 1));
+        let mean = if n > 0 { sum / n as f64 } else { 1.0 };
+        let cell = if mean > 0.0 && mean.is_finite() {
+            2.0 * mean
+        } else {
+            1.0
+        };
+        let mut grid = FaceGrid::new(cell, mesh.face_capacity());
+        for f in mesh.faces() {
+            grid.insert(f.raw(), &face_box(mesh, f));
+        }
+        self.grid = Some(grid);
+        self.grid_faces = mesh.n_faces();
+    }
+
+    fn push(&mut self, e: EdgeId) {
+        let [u, v] = self.mesh.edge_vertices(e);
+        let q = self.quadrics[u.index()].add(&self.quadrics[v.index()]);
+        let (target, cost) = placement(&q, self.mesh.position(u), self.mesh.position(v));
+        self.heap.push(Entry {
+            cost,
+            edge: e.raw(),
+            version: self.versions[e.index()],
+            target,
+        });
+    }
+
+    /// One pass: queue every live edge, then collapse cheapest first until the target is
+    /// reached or the heap is empty. Returns the vetoes of this pass.
+    fn pass(&mut self, target_faces: usize, bound: f64) -> VetoCounts {
+        self.passes += 1;
+        self.heap.clear();
+        let edges: Vec<EdgeId> = self.mesh.edges().collect();
+        for e in edges {
+            self.versions[e.index()] = self.versions[e.index()].wrapping_add(1);
+            self.push(e);
+        }
+        let mut vetoes = VetoCounts::default();
+        while self.mesh.n_faces() > target_faces {
+            let Some(entry) = self.heap.pop() else { break };
+            let e = EdgeId::from_index(entry.edge as usize);
+            if !self.mesh.is_edge_alive(e) || self.versions[e.index()] != entry.version {
+                continue;
+            }
+            let h = e.halfedge();
+            if self.mesh.can_collapse(h).is_err() {
+                vetoes.topology += 1;
+                continue;
+            }
+            match self.geometric_veto(h, entry.target, bound) {
+                Some(Veto::NormalFlip) => vetoes.normal_flip += 1,
+                Some(Veto::Degenerate) => vetoes.degenerate += 1,
+                Some(Veto::Quality) => vetoes.quality += 1,
+                Some(Veto::SelfIntersection) => vetoes.self_intersection += 1,
+                None => {
+                    self.apply(h, entry.target);
+                    self.max_cost = self.max_cost.max(entry.cost);
+                }
+            }
+        }
+        self.vetoes.add(&vetoes);
+        vetoes
+    }
+
+    /// The faces that survive a collapse of `h` and change shape: all faces around both
+    /// endpoints except the two on the edge.
+    fn fan(&self, h: HalfedgeId) -> Vec<FaceId> {
+        let (a, b) = (self.mesh.tail(h), self.mesh.head(h));
+        let gone = [self.mesh.face(h), self.mesh.face(h.twin())];
+        self.mesh
+            .faces_around(a)
+            .chain(self.mesh.faces_around(b))
+            .filter(|f| !gone.contains(f))
+            .collect()
+    }
+
+    fn geometric_veto(&mut self, h: HalfedgeId, p: DVec3, bound: f64) -> Option<Veto> {
+        let mesh = &*self.mesh;
+        let (a, b) = (mesh.tail(h), mesh.head(h));
+        let fan = self.fan(h);
+        let moved = |v: VertexId| {
+            if v == a || v == b {
+                p
+            } else {
+                mesh.position(v)
+            }
+        };
+        let (mut q_old, mut q_new) = (1.0f64, 1.0f64);
+        for &f in &fan {
+            let old = mesh.face_vertices(f).map(|v| mesh.position(v));
+            let new = mesh.face_vertices(f).map(moved);
+            let cross_new = (new[1] - new[0]).cross(new[2] - new[0]);
+            let longest = (0..3)
+                .map(|i| new[i].distance_squared(new[(i + 1) % 3]))
+                .fold(0.0, f64::max);
+            let area2 = cross_new.length();
+            if area2.is_nan() || area2 <= 1e-10 * longest {
+                return Some(Veto::Degenerate);
+            }
+            let cross_old = (old[1] - old[0]).cross(old[2] - old[0]);
+            if cross_old.length() > 0.0
+                && cross_old.normalize().dot(cross_new.normalize()) <= self.options.min_normal_dot
+            {
+                return Some(Veto::NormalFlip);
+            }
+            q_old = q_old.max(triangle_quality(old));
+            q_new = q_new.max(triangle_quality(new));
+        }
+        if q_new > bound && q_new > q_old {
+            return Some(Veto::Quality);
+        }
+        if self.grid.is_some() && self.creates_intersection(h, p, &fan) {
+            return Some(Veto::SelfIntersection);
+        }
+        None
+    }
+
+    /// Whether a face of `fan` (with `tail(h)`, `head(h)` merged at `p`) intersects any other
+    /// face. Moves the two endpoints to `p` for the test and restores them.
+    fn creates_intersection(&mut self, h: HalfedgeId, p: DVec3, fan: &[FaceId]) -> bool {
+        let (a, b) = (self.mesh.tail(h), self.mesh.head(h));
+        let gone = [self.mesh.face(h), self.mesh.face(h.twin())];
+        let (pa, pb) = (self.mesh.position(a), self.mesh.position(b));
+        self.mesh.set_position(a, p);
+        self.mesh.set_position(b, p);
+        let mesh = &*self.mesh;
+        let grid = self.grid.as_mut().expect("grid exists when checking");
+        let relabel = |f: FaceId| {
+            mesh.face_vertices(f)
+                .map(|v| if v == a { b.raw() } else { v.raw() })
+        };
+        let positions = mesh.positions();
+        let mut hit = false;
+        let mut candidates = Vec::new();
+        for &f in fan {
+            let tri = relabel(f);
+            let bx = face_box(mesh, f);
+            candidates.clear();
+            grid.query(&bx, |g| candidates.push(g));
+            candidates.extend(fan.iter().map(|g| g.raw()));
+            for &g in &candidates {
+                let gf = FaceId::from_index(g as usize);
+                if gf == f || gone.contains(&gf) || !mesh.is_face_alive(gf) {
+                    continue;
+                }
+                if !face_box(mesh, gf).overlaps(&bx) {
+                    continue;
+                }
+                if faces_intersect(positions, tri, relabel(gf)) {
+                    hit = true;
+                    break;
+                }
+            }
+            if hit {
+                break;
+            }
+        }
+        self.mesh.set_position(a, pa);
+        self.mesh.set_position(b, pb);
+        hit
+    }
+
+    fn apply(&mut self, h: HalfedgeId, p: DVec3) {
+        let (a, b) = (self.mesh.tail(h), self.mesh.head(h));
+        let q = self.quadrics[a.index()].add(&self.quadrics[b.index()]);
+        let c = self
+            .mesh
+            .collapse(h)
+            .unwrap_or_else(|e| panic!("qem: collapse checked by can_collapse failed (bug): {e}"));
+        self.mesh.set_position(b, p);
+        self.quadrics[b.index()] = q;
+        self.collapses += 1;
+        (self.on_collapse)(&c);
+        if let Some(grid) = self.grid.as_mut() {
+            for f in c.removed_faces {
+                grid.remove(f.raw());
+            }
+            for f in self.mesh.faces_around(b) {
+                grid.insert(f.raw(), &face_box(self.mesh, f));
+            }
+        }
+        let around: Vec<EdgeId> = self.mesh.outgoing(b).map(|o| o.edge()).collect();
+        for e in around {
+            self.versions[e.index()] = self.versions[e.index()].wrapping_add(1);
+            self.push(e);
+        }
+        if self.grid.is_some() && 2 * self.mesh.n_faces() < self.grid_faces {
+            self.rebuild_grid();
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn quality_is_one_for_equilateral_and_grows_for_slivers() {
+        let eq = [
+            DVec3::ZERO,
+            DVec3::X,
+            DVec3::new(0.5, 3f64.sqrt() / 2.0, 0.0),
+        ];
+        assert!((triangle_quality(eq) - 1.0).abs() < 1e-12);
+        let sliver = [DVec3::ZERO, DVec3::X, DVec3::new(0.5, 0.01, 0.0)];
+        assert!(triangle_quality(sliver) > 20.0);
+        assert_eq!(
+            triangle_quality([DVec3::ZERO, DVec3::X, 2.0 * DVec3::X]),
+            f64::INFINITY
+        );
+    }
+
+    #[test]
+    fn minimum_faces_follow_heawood() {
+        assert_eq!(minimum_faces_for_genus(0), 4);
+        assert_eq!(minimum_faces_for_genus(1), 14); // Császár torus, 7 vertices
+        assert_eq!(minimum_faces_for_genus(2), 24); // 10 vertices
+        assert_eq!(minimum_faces_for_genus(3), 28); // 10 vertices (Heawood)
+    }
+}

@@ -1,0 +1,126 @@
+//! Garland–Heckbert quadrics and the one small dense solve behind them.
+
+use glam::DVec3;
+use nalgebra::{Matrix3, Vector3};
+
+/// The error quadric `E(x) = xᵀ A x + 2 bᵀ x + c` of a sum of weighted squared plane distances.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub(crate) struct Quadric {
+    /// Upper triangle of the symmetric A: xx, xy, xz, yy, yz, zz.
+    a: [f64; 6],
+    b: DVec3,
+    c: f64,
+}
+
+impl Quadric {
+    /// `weight · (n·x + d)²` for the plane through `point` with unit normal `n`.
+    pub(crate) fn from_plane(n: DVec3, point: DVec3, weight: f64) -> Quadric {
+        let d = -n.dot(point);
+        Quadric {
+            a: [
+                n.x * n.x,
+                n.x * n.y,
+                n.x * n.z,
+                n.y * n.y,
+                n.y * n.z,
+                n.z * n.z,
+            ]
+            .map(|x| x * weight),
+            b: n * (d * weight),
+            c: d * d * weight,
+        }
+    }
+
+    /// Sum of two quadrics.
+    pub(crate) fn add(&self, o: &Quadric) -> Quadric {
+        let mut a = self.a;
+        for (x, y) in a.iter_mut().zip(o.a) {
+            *x += y;
+        }
+        Quadric {
+            a,
+            b: self.b + o.b,
+            c: self.c + o.c,
+        }
+    }
+
+    /// `E(p)`, clamped at 0 (rounding can make it slightly negative).
+    pub(crate) fn eval(&self, p: DVec3) -> f64 {
+        let [xx, xy, xz, yy, yz, zz] = self.a;
+        let ap = DVec3::new(
+            xx * p.x + xy * p.y + xz * p.z,
+            xy * p.x + yy * p.y + yz * p.z,
+            xz * p.x + yz * p.y + zz * p.z,
+        );
+        (p.dot(ap) + 2.0 * self.b.dot(p) + self.c).max(0.0)
+    }
+
+    /// The minimiser of `E`, `x = −A⁻¹ b`, or `None` when A is (near) singular: its smallest
+    /// eigenvalue is below `1e-8` times its largest (flat or cylindrical neighbourhoods).
+    pub(crate) fn minimizer(&self) -> Option<DVec3> {
+        let [xx, xy, xz, yy, yz, zz] = self.a;
+        let m = Matrix3::new(xx, xy, xz, xy, yy, yz, xz, yz, zz);
+        let eig = m.symmetric_eigen();
+        let max = eig.eigenvalues.iter().fold(0.0f64, |m, &l| m.max(l.abs()));
+        if !(max > 0.0 && max.is_finite()) {
+            return None;
+        }
+        if eig.eigenvalues.iter().any(|&l| l.abs() < 1e-8 * max) {
+            return None;
+        }
+        let rhs = Vector3::new(-self.b.x, -self.b.y, -self.b.z);
+        let q = &eig.eigenvectors;
+        let mut y = q.transpose() * rhs;
+        for i in 0..3 {
+            y[i] /= eig.eigenvalues[i];
+        }
+        let x = q * y;
+        let p = DVec3::new(x[0], x[1], x[2]);
+        p.is_finite().then_some(p)
+    }
+}
+
+/// Placement and cost of merging two vertices with quadric sum `q`: the minimiser of `q` if it
+/// exists and lies within `3·|pa − pb|` of the midpoint, else the best of `pa`, `pb` and the
+/// midpoint.
+pub(crate) fn placement(q: &Quadric, pa: DVec3, pb: DVec3) -> (DVec3, f64) {
+    let mid = 0.5 * (pa + pb);
+    if let Some(p) = q.minimizer()
+        && p.distance(mid) <= 3.0 * pa.distance(pb)
+    {
+        return (p, q.eval(p));
+    }
+    [mid, pa, pb]
+        .into_iter()
+        .map(|p| (p, q.eval(p)))
+        .fold(
+            (mid, f64::INFINITY),
+            |best, c| if c.1 < best.1 { c } else { best },
+        )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn three_planes_meet_at_their_corner() {
+        let corner = DVec3::new(0.3, -0.2, 0.7);
+        let q = Quadric::from_plane(DVec3::X, corner, 1.0)
+            .add(&Quadric::from_plane(DVec3::Y, corner, 2.0))
+            .add(&Quadric::from_plane(DVec3::Z, corner, 0.5));
+        let p = q.minimizer().expect("regular");
+        assert!(p.distance(corner) < 1e-12);
+        assert!(q.eval(p) < 1e-20);
+        assert!((q.eval(corner + DVec3::X) - 1.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn one_plane_is_singular_and_falls_back_to_the_best_candidate() {
+        let q = Quadric::from_plane(DVec3::Z, DVec3::ZERO, 1.0);
+        assert!(q.minimizer().is_none());
+        let (p, cost) = placement(&q, DVec3::new(0.0, 0.0, 1.0), DVec3::new(1.0, 0.0, 0.0));
+        assert_eq!(p, DVec3::new(1.0, 0.0, 0.0));
+        assert_eq!(cost, 0.0);
+    }
+}

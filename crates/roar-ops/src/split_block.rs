@@ -1,0 +1,415 @@
+//! The Face Split block: resolution allocation under a face budget (spec §3.5, §3.8,
+//! Verification notes 1, 5, 8).
+//!
+//! 1. Regular samples of every face (§3.3) with smooth normals, projected onto the target by a
+//!    [`Projector`] (§3.4).
+//! 2. Face scores (§3.5): on each face's projected grid, ROAR vertex normals from the valid
+//!    projected sub-triangles; per sub-triangle `fold(t) = 1 − (1/3) Σ_c ñ_t·ñ_c`, zeroed when
+//!    folded (> 1), invalid, flipped against the source face, or below the threshold (note 1:
+//!    0.02 per sub-triangle by default; the per-face rule is a switch); `S_f = Σ_t fold(t)`,
+//!    zeroed for folded source faces (φ_f > 1) and faces with an edge shorter than 5e-4.
+//! 3. Edge costs `C_e = P_e + QS_e` (P_e = max S over faces touching either endpoint, QS_e = the
+//!    QSlim cost of the best valid placement with the flip and Q ≤ 5 tests, +∞ if none),
+//!    suppression of faces next to edges with `C_e < 1e-3`, independent set with priorities
+//!    `exp(−C_e)`, `c_e = max(C_e, P_e)`.
+//! 4. Pairing and budget (§3.8 steps 6–7, note 8), then collapses, then 1→3 centroid splits
+//!    (the new vertex gets the mean optimizer row), then compaction.
+
+use crate::block::{Block, BlockContext, BlockStats, compact_with_optimizer, sync_optimizer_len};
+use crate::geometry::{Geometry, corner_angles};
+use crate::optim::Optimizer;
+use crate::qslim::{EdgeCost, QSlimOptions, ValidityOptions, edge_cost, vertex_quadrics};
+use crate::select::{SelectOptions, select_independent_edges};
+use rand::SeedableRng;
+use rand_chacha::ChaCha8Rng;
+use rayon::prelude::*;
+use roar_mesh::spatial::{Projector, RegularSamples, RegularSamplingOptions, regular_samples};
+use roar_mesh::{DEGENERATE_CROSS, DVec3, EdgeId, FaceId, Mesh};
+
+/// Where the 0.02 curvature threshold of the face score applies (Verification note 1).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum SplitThreshold {
+    /// A sub-triangle whose fold is below the value counts 0 (the scoring code). Default 0.02.
+    PerSubTriangle(f64),
+    /// Sub-triangles count whatever their fold; a face whose total is below the value scores
+    /// 0 ([SUP] read per face, OQ-5).
+    PerFace(f64),
+}
+
+impl Default for SplitThreshold {
+    fn default() -> Self {
+        SplitThreshold::PerSubTriangle(0.02)
+    }
+}
+
+/// Options of [`face_split`] (spec §3.5, §3.8, notes 1, 5, 8).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FaceSplitOptions {
+    /// Regular sampling of the faces (§3.3; density 0.002, cap n = 16).
+    pub sampling: RegularSamplingOptions,
+    /// Score threshold (note 1). Default 0.02 per sub-triangle.
+    pub threshold: SplitThreshold,
+    /// Faces with an edge shorter than this score 0. Default 5e-4 = 0.1·edge_len_min (§3.5).
+    pub min_edge_length: f64,
+    /// τ_e: edges with `C_e` below this suppress their faces' scores and are collapsed for
+    /// free. Default 1e-3 (`edge_curvature_threshold`, §3.8).
+    pub edge_cost_threshold: f64,
+    /// Cap on splits per call. Default 4000 (`max_faces_to_split`, §3.8, note 8).
+    pub max_faces_to_split: usize,
+    /// Collapse validity: flip test and `Q ≤ 5` (`collapse_quality_threshold`, §3.8 step 2).
+    pub validity: ValidityOptions,
+    /// QSlim weights and vertex-plane variant (§3.10, note 5).
+    pub qslim: QSlimOptions,
+    /// Independent selection (§3.11).
+    pub select: SelectOptions,
+    /// Seed of the sampler's stochastic rounding (the block wrapper mixes in the iteration).
+    pub seed: u64,
+}
+
+impl Default for FaceSplitOptions {
+    fn default() -> Self {
+        Self {
+            sampling: RegularSamplingOptions::default(),
+            threshold: SplitThreshold::default(),
+            min_edge_length: 5e-4,
+            edge_cost_threshold: 1e-3,
+            max_faces_to_split: 4000,
+            validity: ValidityOptions {
+                max_quality: Some(5.0),
+                ..ValidityOptions::default()
+            },
+            qslim: QSlimOptions::default(),
+            select: SelectOptions::default(),
+            seed: 0,
+        }
+    }
+}
+
+/// Face scores `S_f` (spec §3.5) of a **compact** mesh, by face id, from its regular samples and
+/// their projections (`projected[i]` for `samples.points[i]`). Runs in parallel over faces
+/// (deterministic: each face is independent).
+pub fn face_scores(
+    mesh: &Mesh,
+    geometry: &Geometry,
+    samples: &RegularSamples,
+    projected: &[Option<DVec3>],
+    options: &FaceSplitOptions,
+) -> Vec<f64> {
+    let folds = geometry.face_folds(mesh);
+    let (sub_threshold, face_threshold) = match options.threshold {
+        SplitThreshold::PerSubTriangle(t) => (t, 0.0),
+        SplitThreshold::PerFace(t) => (0.0, t),
+    };
+    (0..mesh.face_capacity())
+        .into_par_iter()
+        .with_min_len(256)
+        .map_init(
+            || (Vec::new(), Vec::new()),
+            |(normals, subs): &mut (Vec<DVec3>, Vec<Option<DVec3>>), f| {
+                let face = FaceId::from_index(f);
+                if !mesh.is_face_alive(face) || folds[f] > 1.0 {
+                    return 0.0;
+                }
+                if mesh
+                    .face_halfedges(face)
+                    .iter()
+                    .any(|h| mesh.edge_length(h.edge()) < options.min_edge_length)
+                {
+                    return 0.0;
+                }
+                let s = grid_score(
+                    samples,
+                    projected,
+                    f,
+                    geometry.face_normals[f],
+                    sub_threshold,
+                    normals,
+                    subs,
+                );
+                if s < face_threshold || s.is_nan() || s < 0.0 {
+                    0.0
+                } else {
+                    s
+                }
+            },
+        )
+        .collect()
+}
+
+/// `Σ_t fold(t)` over face `f`'s projected grid (§3.5 steps 1–4). `normals`/`subs` are scratch.
+/// [INF: a projected sub-triangle with `|cross| ≤ 1e-9` counts as invalid.]
+fn grid_score(
+    samples: &RegularSamples,
+    projected: &[Option<DVec3>],
+    f: usize,
+    face_normal: DVec3,
+    sub_threshold: f64,
+    normals: &mut Vec<DVec3>,
+    subs: &mut Vec<Option<DVec3>>,
+) -> f64 {
+    let points = samples.face_samples(f);
+    let start = points.start;
+    normals.clear();
+    normals.resize(points.len(), DVec3::ZERO);
+    subs.clear();
+    for t in samples.face_sub_triangles(f) {
+        let idx = samples.sub_triangles[t];
+        let q = match (
+            projected.get(idx[0] as usize).copied().flatten(),
+            projected.get(idx[1] as usize).copied().flatten(),
+            projected.get(idx[2] as usize).copied().flatten(),
+        ) {
+            (Some(a), Some(b), Some(c)) => [a, b, c],
+            _ => {
+                subs.push(None);
+                continue;
+            }
+        };
+        let cross = (q[1] - q[0]).cross(q[2] - q[0]);
+        let len = cross.length();
+        if len.is_nan() || len <= DEGENERATE_CROSS || !len.is_finite() {
+            subs.push(None);
+            continue;
+        }
+        let n = cross / len;
+        let area = 0.5 * len;
+        let angles = corner_angles(q);
+        for k in 0..3 {
+            normals[idx[k] as usize - start] += area * angles[k] * n;
+        }
+        subs.push(Some(n));
+    }
+    for n in normals.iter_mut() {
+        *n = n.normalize_or_zero();
+    }
+    let mut score = 0.0;
+    for (t, n) in samples.face_sub_triangles(f).zip(subs.iter()) {
+        let Some(n) = *n else { continue };
+        if n.dot(face_normal) < 0.0 {
+            continue;
+        }
+        let idx = samples.sub_triangles[t];
+        let fold = 1.0
+            - idx
+                .iter()
+                .map(|&i| n.dot(normals[i as usize - start]))
+                .sum::<f64>()
+                / 3.0;
+        if fold > 1.0 || fold < sub_threshold {
+            continue;
+        }
+        score += fold;
+    }
+    score
+}
+
+/// Runs the Face Split block (spec §3.8) with face budget `face_budget` and target projector
+/// `projector`; compacts the mesh and optimizer rows if the topology changed.
+///
+/// Stats: `candidates` = faces with a positive score after suppression; `accepted` = face
+/// splits; `rejected`: `"budget"` (scored faces not split), `"link"`, `"sampling"`;
+/// `counters`: `faces_before`, `faces_after`, `independent_edges`, `swaps` (k),
+/// `paired_collapses`, `free_collapses`, `suppressed_edges`.
+pub fn face_split(
+    mesh: &mut Mesh,
+    optimizer: &mut Optimizer,
+    projector: &dyn Projector,
+    face_budget: usize,
+    options: &FaceSplitOptions,
+) -> BlockStats {
+    let mut stats = BlockStats::new("face_split");
+    if mesh.vertex_capacity() != mesh.n_vertices()
+        || mesh.face_capacity() != mesh.n_faces()
+        || mesh.edge_capacity() != mesh.n_edges()
+    {
+        compact_with_optimizer(mesh, optimizer);
+    }
+    sync_optimizer_len(mesh, optimizer);
+    let n_faces = mesh.n_faces();
+    stats.count("faces_before", n_faces);
+
+    // 1. Samples, projection, face scores.
+    let geometry = Geometry::compute(mesh);
+    let triangles: Vec<[u32; 3]> = mesh
+        .faces()
+        .map(|f| mesh.face_vertices(f).map(|v| v.raw()))
+        .collect();
+    let mut rng = ChaCha8Rng::seed_from_u64(options.seed);
+    let samples = match regular_samples(
+        mesh.positions(),
+        &triangles,
+        Some(&geometry.vertex_normals),
+        &options.sampling,
+        &mut rng,
+    ) {
+        Ok(s) => s,
+        Err(_) => {
+            stats.reject("sampling", 1);
+            return stats;
+        }
+    };
+    let projected = projector.project(
+        mesh.positions(),
+        &triangles,
+        &samples.points,
+        &samples.normals,
+    );
+    let mut scores = face_scores(mesh, &geometry, &samples, &projected, options);
+
+    // 2. Edge costs C_e = P_e + QS_e.
+    let mut vertex_max = vec![0.0f64; mesh.vertex_capacity()];
+    for f in mesh.faces() {
+        for v in mesh.face_vertices(f) {
+            vertex_max[v.index()] = vertex_max[v.index()].max(scores[f.index()]);
+        }
+    }
+    let quadrics = vertex_quadrics(mesh, &geometry, &options.qslim);
+    let edges: Vec<EdgeId> = mesh.edges().collect();
+    let costs: Vec<(f64, f64, Option<EdgeCost>)> = edges
+        .par_iter()
+        .with_min_len(512)
+        .map(|&e| {
+            let [a, b] = mesh.edge_vertices(e);
+            let potential = vertex_max[a.index()].max(vertex_max[b.index()]);
+            match edge_cost(mesh, &quadrics, e, &options.validity) {
+                Ok(c) => (potential + c.cost, potential, Some(c)),
+                Err(_) => (f64::INFINITY, potential, None),
+            }
+        })
+        .collect();
+
+    // 3. Suppression of flat, redundant neighbourhoods.
+    let mut suppressed = 0;
+    for (&e, &(cost, _, _)) in edges.iter().zip(&costs) {
+        if cost < options.edge_cost_threshold {
+            suppressed += 1;
+            let h = e.halfedge();
+            scores[mesh.face(h).index()] = 0.0;
+            scores[mesh.face(h.twin()).index()] = 0.0;
+        }
+    }
+    stats.count("suppressed_edges", suppressed);
+
+    // 4. Independent edge set by exp(−C_e); 5. c_e = max(C_e, P_e).
+    let mut priority = vec![0.0; mesh.edge_capacity()];
+    for (&e, &(cost, _, _)) in edges.iter().zip(&costs) {
+        priority[e.index()] = (-cost).exp();
+    }
+    let selection = select_independent_edges(mesh, &priority, &options.select);
+    stats.reject("link", selection.link_rejected);
+    stats.count("independent_edges", selection.edges.len());
+    // Edge ids are dense (compact mesh), so `costs[e]` is edge e's entry.
+    let mut chosen: Vec<(f64, EdgeId)> = selection
+        .edges
+        .iter()
+        .map(|&e| {
+            let (cost, potential, _) = costs[e.index()];
+            (cost.max(potential), e)
+        })
+        .collect();
+    chosen.sort_by(|x, y| x.0.total_cmp(&y.0).then(x.1.cmp(&y.1)));
+
+    // 6. Pairing: faces by S descending, edges by c ascending.
+    let mut ranked: Vec<FaceId> = mesh.faces().filter(|f| scores[f.index()] > 0.0).collect();
+    ranked.sort_by(|x, y| {
+        scores[y.index()]
+            .total_cmp(&scores[x.index()])
+            .then(x.cmp(y))
+    });
+    stats.candidates = ranked.len();
+    let swaps = ranked
+        .iter()
+        .zip(&chosen)
+        .take_while(|(f, (c, _))| scores[f.index()] > *c)
+        .count();
+    stats.count("swaps", swaps);
+
+    // 7. Budget logic.
+    let delta = (face_budget as i64 - n_faces as i64).div_euclid(2);
+    let (n_paired, n_split) = if delta > 1 {
+        (0, ranked.len().min(delta as usize))
+    } else {
+        (swaps, (swaps as i64 + delta.min(0)).max(0) as usize)
+    };
+    let n_split = n_split.min(options.max_faces_to_split);
+    let mut to_collapse: Vec<EdgeId> = chosen[..n_paired].iter().map(|&(_, e)| e).collect();
+    let free: Vec<EdgeId> = chosen[n_paired..]
+        .iter()
+        .filter(|(c, _)| *c < options.edge_cost_threshold)
+        .map(|&(_, e)| e)
+        .collect();
+    stats.count("paired_collapses", to_collapse.len());
+    stats.count("free_collapses", free.len());
+    to_collapse.extend(free);
+
+    // 8. Apply: collapses, then centroid splits.
+    let mut collapsed = 0;
+    for e in to_collapse {
+        let c = costs[e.index()]
+            .2
+            .expect("selected edges have finite cost, so a placement");
+        match mesh.collapse(c.halfedge) {
+            Ok(out) => {
+                optimizer
+                    .on_collapse(out.survivor.raw(), c.keep.raw())
+                    .expect("optimizer rows cover every vertex slot (invariant)");
+                collapsed += 1;
+            }
+            Err(_) => stats.reject("link", 1),
+        }
+    }
+    for &f in &ranked[..n_split] {
+        if !mesh.is_face_alive(f) {
+            stats.reject("removed_face", 1);
+            continue;
+        }
+        let s = mesh.split_face(f, [1.0 / 3.0; 3]);
+        sync_optimizer_len(mesh, optimizer);
+        optimizer
+            .on_face_split(s.new_vertex.raw(), s.parents.map(|v| v.raw()))
+            .expect("optimizer rows cover every vertex slot (invariant)");
+        stats.accepted += 1;
+    }
+    stats.reject("budget", ranked.len() - n_split);
+    if collapsed > 0 || stats.accepted > 0 {
+        compact_with_optimizer(mesh, optimizer);
+    }
+    stats.count("faces_after", mesh.n_faces());
+    stats
+}
+
+/// [`Block`] wrapper of [`face_split`]: takes the budget and projector from the context and
+/// mixes the iteration into the sampling seed. Without a projector it does nothing
+/// (`rejected["no_projector"] = 1`).
+#[derive(Debug, Clone, Default)]
+pub struct FaceSplit {
+    /// Options passed to [`face_split`].
+    pub options: FaceSplitOptions,
+}
+
+impl Block for FaceSplit {
+    fn name(&self) -> &'static str {
+        "face_split"
+    }
+
+    fn apply(
+        &mut self,
+        mesh: &mut Mesh,
+        optimizer: &mut Optimizer,
+        ctx: &BlockContext,
+    ) -> BlockStats {
+        let Some(projector) = ctx.projector else {
+            let mut stats = BlockStats::new("face_split");
+            stats.reject("no_projector", 1);
+            return stats;
+        };
+        let options = FaceSplitOptions {
+            seed: self
+                .options
+                .seed
+                .wrapping_add((ctx.iteration as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15)),
+            ..self.options
+        };
+        face_split(mesh, optimizer, projector, ctx.face_budget, &options)
+    }
+}

@@ -1,0 +1,220 @@
+//! QEM decimation: exact budgets, no new self-intersections, topology kept, clear errors.
+
+use proptest::prelude::*;
+use roar_mesh::Mesh;
+use roar_mesh::shapes::{icosphere, perturbed, torus};
+use roar_mesh::spatial::self_intersecting_faces;
+use roar_ops::qem::{DecimateError, DecimateOptions, decimate, decimate_with, minimum_faces};
+
+fn intersecting_faces(mesh: &Mesh) -> usize {
+    let (p, t) = mesh.to_triangles();
+    self_intersecting_faces(&p, &t)
+        .iter()
+        .filter(|&&x| x)
+        .count()
+}
+
+/// Decimates a copy to `target` and checks every promise of `decimate`.
+fn decimate_and_check(mesh: &Mesh, target: usize) -> Mesh {
+    let mut m = mesh.clone();
+    let (components, genus) = (m.components().0, m.genus());
+    let stats = decimate(&mut m, target, &DecimateOptions::default())
+        .unwrap_or_else(|e| panic!("decimate to {target}: {e}"));
+    assert_eq!(m.n_faces(), target);
+    assert!(stats.reached_target && !stats.noop);
+    assert_eq!(stats.final_faces, target);
+    m.validate().expect("valid after decimation");
+    assert_eq!(m.components().0, components);
+    assert_eq!(m.genus(), genus);
+    assert_eq!(
+        intersecting_faces(&m),
+        0,
+        "self-intersections after decimation to {target}"
+    );
+    assert!(m.signed_volume() > 0.0, "orientation kept");
+    m
+}
+
+#[test]
+fn icosphere_reaches_exact_budgets_and_stays_on_the_sphere() {
+    let sphere = icosphere(5); // 20480 faces
+    for target in [5000, 1000, 500] {
+        let m = decimate_and_check(&sphere, target);
+        let worst = m
+            .vertices()
+            .map(|v| (m.position(v).length() - 1.0).abs())
+            .fold(0.0, f64::max);
+        assert!(
+            worst < 0.03,
+            "vertex {worst} off the unit sphere at {target} faces"
+        );
+    }
+}
+
+#[test]
+fn torus_reaches_exact_budgets_keeping_genus_one() {
+    let t = torus(96, 48, 1.0, 0.35); // 9216 faces
+    for target in [5000, 1000, 500] {
+        let m = decimate_and_check(&t, target);
+        assert_eq!(m.genus(), 1);
+    }
+}
+
+#[test]
+fn collapse_callback_sees_every_collapse_and_remap_matches() {
+    let mut m = icosphere(3);
+    let before = m.n_faces();
+    let mut seen = 0;
+    let stats = decimate_with(&mut m, 200, &DecimateOptions::default(), |c| {
+        assert_ne!(c.survivor, c.removed);
+        seen += 1;
+    })
+    .unwrap();
+    assert_eq!(seen, stats.collapses);
+    assert_eq!(seen, (before - 200) / 2);
+    let remap = stats.remap.expect("compacted");
+    assert_eq!(remap.vertices.iter().flatten().count(), m.n_vertices());
+}
+
+#[test]
+fn odd_budget_is_refused_naming_the_even_neighbours() {
+    let mut m = icosphere(2);
+    let before = m.clone();
+    let err = decimate(&mut m, 101, &DecimateOptions::default()).unwrap_err();
+    assert!(matches!(
+        err,
+        DecimateError::OddTarget {
+            below: 100,
+            above: 102,
+            ..
+        }
+    ));
+    assert!(err.to_string().contains("100 or 102"), "{err}");
+    assert_eq!(m, before);
+}
+
+#[test]
+fn impossible_budgets_are_refused_up_front() {
+    let mut sphere = icosphere(2);
+    let err = decimate(&mut sphere, 2, &DecimateOptions::default()).unwrap_err();
+    assert!(
+        matches!(err, DecimateError::TargetBelowMinimum { minimum: 4, .. }),
+        "{err}"
+    );
+    let mut t = torus(12, 8, 1.0, 0.4);
+    assert_eq!(minimum_faces(&t), 14);
+    let err = decimate(&mut t, 12, &DecimateOptions::default()).unwrap_err();
+    assert!(err.to_string().contains("at least 14 faces"), "{err}");
+}
+
+#[test]
+fn target_at_or_above_the_count_is_a_noop() {
+    let mut m = icosphere(1);
+    let before = m.clone();
+    let stats = decimate(&mut m, 400, &DecimateOptions::default()).unwrap();
+    assert!(stats.noop && !stats.reached_target && stats.remap.is_none());
+    assert_eq!(m, before);
+    let stats = decimate(&mut m, 80, &DecimateOptions::default()).unwrap();
+    assert!(stats.noop && stats.reached_target);
+}
+
+#[test]
+fn blocked_budget_is_a_named_error_or_the_closest_mesh_with_best_effort() {
+    // A thin torus pushed to its 14-face minimum: greedy collapses with strict vetoes stop early.
+    let t = torus(24, 8, 1.0, 0.1);
+    let strict = DecimateOptions {
+        min_normal_dot: 0.9,
+        quality_bounds: vec![1.5],
+        max_passes_per_bound: 2,
+        ..DecimateOptions::default()
+    };
+    let mut m = t.clone();
+    let err = decimate(&mut m, 14, &strict).unwrap_err();
+    let DecimateError::BudgetNotReached {
+        target,
+        reached,
+        reasons,
+    } = &err
+    else {
+        panic!("expected BudgetNotReached, got {err}");
+    };
+    assert_eq!(*target, 14);
+    assert!(*reached > 14 && *reached <= t.n_faces());
+    assert!(reasons.total() > 0);
+    assert_eq!(err.to_string().lines().count(), 1);
+    assert!(err.to_string().contains("stopped at"), "{err}");
+    m.validate().unwrap();
+
+    let mut m = t.clone();
+    let best = DecimateOptions {
+        best_effort: true,
+        ..strict
+    };
+    let stats = decimate(&mut m, 14, &best).unwrap();
+    assert!(!stats.reached_target);
+    assert_eq!(
+        m.n_faces(),
+        *reached,
+        "best effort keeps the same closest mesh"
+    );
+    m.validate().unwrap();
+    assert_eq!(intersecting_faces(&m), 0);
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(16))]
+    #[test]
+    fn random_perturbed_shapes_stay_valid_and_never_intersect(
+        seed in 0u64..1000,
+        amplitude in 0.0f64..0.04,
+        use_torus in any::<bool>(),
+        frac in 0.05f64..0.9,
+    ) {
+        let base = if use_torus { torus(20, 10, 1.0, 0.4) } else { icosphere(3) };
+        let mesh = perturbed(&base, amplitude, seed);
+        let clean = intersecting_faces(&mesh) == 0;
+        let target = ((base.n_faces() as f64 * frac) as usize / 2 * 2).max(minimum_faces(&base));
+        let mut m = mesh.clone();
+        let opts = DecimateOptions { best_effort: true, ..DecimateOptions::default() };
+        let stats = decimate(&mut m, target, &opts).unwrap();
+        prop_assert!(m.validate().is_ok());
+        prop_assert_eq!(m.genus(), base.genus());
+        prop_assert!(m.n_faces() >= target);
+        if clean {
+            prop_assert_eq!(intersecting_faces(&m), 0);
+        }
+        if stats.reached_target {
+            prop_assert_eq!(m.n_faces(), target);
+        }
+    }
+}
+
+/// Timing of a large decimation (run with `cargo test --release -p roar-ops --test
+/// qem_decimation -- --ignored --nocapture`).
+#[test]
+#[ignore]
+fn timing_100k_to_5k() {
+    let t = torus(250, 200, 1.0, 0.35); // 100 000 faces
+    let start = std::time::Instant::now();
+    let m = decimate_and_check(&t, 5000);
+    println!(
+        "torus 100k -> 5k faces: {:.2?} (incl. checks)",
+        start.elapsed()
+    );
+    let mut m2 = t.clone();
+    let start = std::time::Instant::now();
+    let stats = decimate(&mut m2, 5000, &DecimateOptions::default()).unwrap();
+    println!("decimate only: {:.2?}, {:?}", start.elapsed(), stats.vetoes);
+    let mut m3 = t.clone();
+    let opts = DecimateOptions {
+        check_self_intersections: false,
+        ..DecimateOptions::default()
+    };
+    let start = std::time::Instant::now();
+    decimate(&mut m3, 5000, &opts).unwrap();
+    println!(
+        "decimate without intersection veto: {:.2?}",
+        start.elapsed()
+    );
+    assert_eq!(m.n_faces(), 5000);
+}
