@@ -95,8 +95,8 @@ fn main() {
 #[allow(dead_code)]
 pub fn breakdown(p: &[DVec3], t: &[[u32; 3]]) {
     let start = Instant::now();
-    let a = roar_eval::sampling::sample_surface(p, t, 200_000, 0);
-    let b = roar_eval::sampling::sample_surface(p, t, 200_000, 1);
+    let a = roar_mesh::spatial::sample_surface(p, t, 200_000, 0);
+    let b = roar_mesh::spatial::sample_surface(p, t, 200_000, 1);
     println!(
         "  sampling 2 x 200k: {:.3} s",
         start.elapsed().as_secs_f64()

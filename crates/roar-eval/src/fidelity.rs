@@ -5,7 +5,7 @@ use glam::DVec3;
 use serde::Serialize;
 
 use crate::nearest::{Nearest, nearest_neighbours};
-use crate::sampling::{SurfaceSamples, sample_surface};
+use roar_mesh::spatial::{SurfaceSamples, sample_surface};
 
 /// How the two surfaces are sampled for Chamfer and normal similarity.
 #[derive(Debug, Clone, PartialEq)]

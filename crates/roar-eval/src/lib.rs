@@ -8,21 +8,26 @@
 //!   duplicate positions first.
 //! - [`triangle_quality`]: aspect ratio `Q = R/(2r)` statistics.
 //! - [`fidelity`]: Chamfer L2 (mean and PyTorch3D squared-sum forms), Hausdorff and normal cosine
-//!   similarity against a reference, from area-weighted samples and k-d tree nearest neighbours.
+//!   similarity against a reference, from area-weighted samples (`roar_mesh::spatial::sample_surface`)
+//!   and k-d tree nearest neighbours.
+//! - [`self_intersections`]: faces intersecting a non-adjacent face (exact, on the welded mesh),
+//!   and the paper's ε-offset variant.
 //! - [`evaluate`] gathers everything in a serde [`Report`].
 
 mod fidelity;
 mod nearest;
 mod quality;
 mod report;
-pub mod sampling;
+mod self_intersections;
 mod topology;
 
 pub use fidelity::{ChamferOptions, FidelityStats, bbox_diagonal, fidelity};
 pub use nearest::{Nearest, nearest_neighbours};
 pub use quality::{QualityStats, aspect_ratio, triangle_quality};
-pub use report::{
-    EvalOptions, OrientationStats, Report, SelfIntersectionStats, evaluate, validate_soup,
+pub use report::{EvalOptions, OrientationStats, Report, evaluate, validate_soup};
+pub use self_intersections::{
+    SelfIntersectionOptions, SelfIntersectionStats, area_weighted_vertex_normals,
+    self_intersections,
 };
 pub use topology::{TopologyStats, signed_volume, topology, weld_bit_identical};
 

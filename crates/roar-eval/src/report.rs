@@ -6,13 +6,28 @@ use serde::Serialize;
 use crate::EvalError;
 use crate::fidelity::{ChamferOptions, FidelityStats, fidelity};
 use crate::quality::{QualityStats, triangle_quality};
+use crate::self_intersections::{
+    SelfIntersectionOptions, SelfIntersectionStats, self_intersections,
+};
 use crate::topology::{TopologyStats, signed_volume, topology, weld_bit_identical};
 
 /// What [`evaluate`] computes and how.
-#[derive(Debug, Clone, Default, PartialEq)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct EvalOptions {
     /// Sampling for Chamfer, Hausdorff and normal similarity (spec §6.1.1–2).
     pub chamfer: ChamferOptions,
+    /// Self-intersections (spec §6.1.4) with these options, or `None` to skip them (they cost a
+    /// BVH pass and exact tests; on by default).
+    pub self_intersections: Option<SelfIntersectionOptions>,
+}
+
+impl Default for EvalOptions {
+    fn default() -> Self {
+        Self {
+            chamfer: ChamferOptions::default(),
+            self_intersections: Some(SelfIntersectionOptions::default()),
+        }
+    }
 }
 
 /// Orientation of the whole soup.
@@ -20,18 +35,6 @@ pub struct EvalOptions {
 pub struct OrientationStats {
     /// `Σ a·(b×c)/6` over all triangles: positive for an outward-wound closed mesh.
     pub signed_volume: f64,
-}
-
-/// Self-intersecting faces (spec §6.1.4). Filled in by the exact triangle–triangle test of
-/// `roar_mesh::spatial` once it is wired in.
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct SelfIntersectionStats {
-    /// Faces that intersect a non-adjacent face.
-    pub faces: usize,
-    /// `faces` divided by the face count.
-    pub fraction: f64,
-    /// Of `faces`, those whose intersections vanish under an ε offset along vertex normals.
-    pub faces_eps_discounted: usize,
 }
 
 /// Every metric of one mesh; serialized as the `eval` JSON report.
@@ -48,7 +51,7 @@ pub struct Report {
     /// Distances and normal agreement to the reference, when one is given and both have area.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub fidelity: Option<FidelityStats>,
-    /// Self-intersections, when computed.
+    /// Self-intersections on the welded mesh, unless skipped by the options.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub self_intersections: Option<SelfIntersectionStats>,
 }
@@ -78,7 +81,8 @@ pub fn validate_soup(
 /// Evaluates a mesh (any soup) and, with a reference, its fidelity to it.
 ///
 /// Fails only on invalid input (out-of-range index, non-finite coordinate) in either soup.
-/// Deterministic for given options. `self_intersections` is left `None` for now.
+/// Deterministic for given options. Self-intersections are computed on the mesh welded at
+/// bit-identical positions, like `topology_welded`.
 pub fn evaluate(
     positions: &[DVec3],
     triangles: &[[u32; 3]],
@@ -99,6 +103,9 @@ pub fn evaluate(
         },
         fidelity: reference
             .and_then(|(rp, rt)| fidelity(positions, triangles, rp, rt, &options.chamfer)),
-        self_intersections: None,
+        self_intersections: options
+            .self_intersections
+            .as_ref()
+            .map(|o| self_intersections(&welded_positions, &welded_triangles, o)),
     })
 }

@@ -76,6 +76,7 @@ fn report_serializes_its_sections() {
     let (p, t) = cube();
     let opts = EvalOptions {
         chamfer: options(2_000, 0),
+        self_intersections: None,
     };
     let without = evaluate(&p, &t, None, &opts).unwrap();
     let json = serde_json::to_value(&without).unwrap();
@@ -113,6 +114,52 @@ fn report_serializes_its_sections() {
     ] {
         assert!(json["fidelity"][key].is_number(), "missing fidelity.{key}");
     }
+
+    let by_default = evaluate(&p, &t, None, &EvalOptions::default()).unwrap();
+    let json = serde_json::to_value(&by_default).unwrap();
+    for key in ["faces", "fraction", "faces_eps_discounted", "offset"] {
+        assert!(
+            json["self_intersections"][key].is_number(),
+            "missing self_intersections.{key}"
+        );
+    }
+    assert_eq!(json["self_intersections"]["faces"], 0);
+}
+
+/// An STL-like soup (every triangle with its own three vertices) of two unit cubes, the second
+/// shifted by `shift`.
+fn two_cube_soup(shift: DVec3) -> (Vec<DVec3>, Vec<[u32; 3]>) {
+    let (p, t) = cube();
+    let mut sp = Vec::new();
+    let mut st = Vec::new();
+    for offset in [DVec3::ZERO, shift] {
+        for f in &t {
+            let base = sp.len() as u32;
+            sp.extend(f.map(|i| p[i as usize] + offset));
+            st.push([base, base + 1, base + 2]);
+        }
+    }
+    (sp, st)
+}
+
+#[test]
+fn self_intersections_are_counted_on_the_welded_soup() {
+    // Without welding every pair of neighbouring triangles would touch at unshared vertices.
+    let (p, t) = two_cube_soup(DVec3::splat(10.0));
+    let r = evaluate(&p, &t, None, &EvalOptions::default()).unwrap();
+    let s = r.self_intersections.unwrap();
+    assert_eq!((s.faces, s.faces_eps_discounted), (0, 0));
+
+    // Interpenetrating cubes: corner of the second inside the first. Three faces of each cube
+    // pass through the other (each face is two triangles, both cut or touched).
+    let (p, t) = two_cube_soup(DVec3::splat(0.5));
+    let s = evaluate(&p, &t, None, &EvalOptions::default())
+        .unwrap()
+        .self_intersections
+        .unwrap();
+    assert!(s.faces >= 6 && s.faces <= 12, "faces {}", s.faces);
+    assert_eq!(s.faces_eps_discounted, s.faces, "deep crossings survive ε");
+    assert!((s.fraction - s.faces as f64 / 24.0).abs() < 1e-15);
 }
 
 #[test]

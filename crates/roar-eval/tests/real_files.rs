@@ -5,7 +5,9 @@ mod common;
 use std::collections::BTreeMap;
 use std::path::Path;
 
-use roar_eval::{signed_volume, topology, weld_bit_identical};
+use roar_eval::{
+    SelfIntersectionOptions, self_intersections, signed_volume, topology, weld_bit_identical,
+};
 
 /// One row of a "Measured characteristics" table, by column name.
 struct Row {
@@ -134,4 +136,77 @@ fn welded_topology_matches_sources_md() {
         mismatches.len(),
         mismatches.join("\n")
     );
+}
+
+/// Files where MeshLab's `selfX` and our exact count differ by more than the tolerance, with our
+/// count (exact arithmetic, deterministic, so pinned). Measured differences and their causes:
+/// MeshLab (vcg `TestFaceFaceIntersection`) skips pairs sharing two vertices (faces folded onto
+/// each other across an edge, e.g. at non-manifold edges), tests pairs sharing one vertex only
+/// with a floating-point segment through the two edge midpoints (missing coplanar overlaps), and
+/// decides contacts in floating point, so exact touches (a corner on a face, coplanar faces
+/// meeting along an edge) are found for some files and missed for others. Faces that intersect
+/// with the triangles shrunk by 1e-6 toward their centroids ("proper" crossings, plus duplicates,
+/// without pairs sharing a vertex) are given after "proper" for comparison.
+const SELF_X_EXCEPTIONS: [(&str, usize); 12] = [
+    ("trimesh-cycloidal.ply", 23_364), // selfX 17,433; proper 21,625
+    ("trimesh-box.STL", 2_320),        // selfX 653; proper 1,565 (touching bodies)
+    ("trimesh-featuretype.STL", 896),  // selfX 825; proper 0: only touches at cracks
+    ("trimesh-angle_block.STL", 111),  // selfX 77; proper 0, 48 with a shared vertex
+    ("trimesh-not_convex.obj", 60),    // selfX 0; 12 non-manifold edges with folded faces
+    ("manifoldplus-bathtub.obj", 30),  // selfX 4; proper 2, 29 with a shared vertex
+    ("manifoldplus-bed.obj", 658),     // selfX 375; proper 402
+    ("manifoldplus-chair.off", 1_520), // selfX 538; proper 1,463 (duplicates, touches)
+    ("manifoldplus-table.off", 418),   // selfX 219; proper 379
+    ("manifold-input.obj", 57_652),    // selfX 53,508; proper 57,652 (coplanar twins)
+    ("c3d-beetle.obj", 71),            // selfX 64; proper 40, 71 with a shared vertex
+    ("luke-cruiser.obj", 332),         // selfX 284; proper 332
+];
+
+/// Self-intersecting faces agree with `SOURCES.md`'s `selfX` (MeshLab on the welded mesh).
+///
+/// Rule: `|ours − selfX| ≤ max(5, 2 % of selfX)`. The slack of 5 covers overlaps beyond a shared
+/// vertex that exact arithmetic finds and MeshLab's midpoint test misses (horse: 5 against 3,
+/// dragon and camelhead likewise agree only with them counted); 2 % covers floating-point
+/// decisions on touching contacts in large soups (trimesh-chair_model: 12,756 against 12,752).
+/// Files beyond it are listed in [`SELF_X_EXCEPTIONS`] with the reason: there our count must
+/// be at least MeshLab's (we never miss what it finds) and equal the pinned exact figure.
+/// Only files up to `max_faces` faces are checked (the full set is an ignored test).
+fn check_self_intersections(max_faces: usize) {
+    let Some(root) = common::test_data() else {
+        return;
+    };
+    let sources = std::fs::read_to_string(root.join("SOURCES.md")).expect("SOURCES.md");
+    let mut failures = Vec::new();
+    let mut checked = 0;
+    for row in parse_sources(&sources) {
+        if int(&row.cells["F"]) as usize > max_faces {
+            continue;
+        }
+        checked += 1;
+        let soup = common::load(&root.join(row.folder).join(&row.file));
+        let (wp, wt) = weld_bit_identical(&soup.positions, &soup.triangles);
+        let s = self_intersections(&wp, &wt, &SelfIntersectionOptions::default());
+        let want = int(&row.cells["selfX"]) as usize;
+        assert!(s.faces_eps_discounted <= s.faces);
+        let ok = match SELF_X_EXCEPTIONS.iter().find(|e| e.0 == row.file) {
+            Some(&(_, pinned)) => s.faces == pinned && s.faces >= want,
+            None => s.faces.abs_diff(want) as f64 <= (0.02 * want as f64).max(5.0),
+        };
+        if !ok {
+            failures.push(format!("{}: selfX {want}, ours {}", row.file, s.faces));
+        }
+    }
+    assert!(checked > 0, "no file checked");
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+}
+
+#[test]
+fn self_intersections_match_sources_md_on_small_files() {
+    check_self_intersections(25_000);
+}
+
+#[test]
+#[ignore = "slow in debug (about a minute): every file, up to 100k faces; run in release"]
+fn self_intersections_match_sources_md_on_every_file() {
+    check_self_intersections(usize::MAX);
 }

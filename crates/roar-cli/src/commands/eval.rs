@@ -38,6 +38,7 @@ pub fn run(args: &EvalArgs) -> anyhow::Result<()> {
             samples: args.samples,
             seed: args.seed,
         },
+        ..EvalOptions::default()
     };
     let report = roar_eval::evaluate(
         &mesh.positions,
