@@ -196,3 +196,89 @@ fn render_writes_one_png_per_view_and_cameras_json() {
     ]);
     assert_one_line_error(&bad, "render --views 5");
 }
+
+#[test]
+fn init_then_decimate_gives_a_closed_mesh_with_the_exact_budget() {
+    let dir = tempfile::tempdir().unwrap();
+    let soup = dir.path().join("chair.obj");
+    assert!(
+        roar(&["example-soup", soup.to_str().unwrap()])
+            .status
+            .success()
+    );
+    let init = dir.path().join("init.ply");
+    let output = roar(&[
+        "init",
+        soup.to_str().unwrap(),
+        "-o",
+        init.to_str().unwrap(),
+        "--resolution",
+        "32",
+        "--faces",
+        "1000",
+    ]);
+    assert!(
+        output.status.success(),
+        "{}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    let decimated = dir.path().join("small.off");
+    let output = roar(&[
+        "decimate",
+        init.to_str().unwrap(),
+        "-o",
+        decimated.to_str().unwrap(),
+        "--faces",
+        "200",
+    ]);
+    assert!(
+        output.status.success(),
+        "{}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    let info = roar(&["info", "--json", decimated.to_str().unwrap()]);
+    let json: serde_json::Value = serde_json::from_slice(&info.stdout).unwrap();
+    assert_eq!(json["faces"], 200);
+    assert_eq!(json["closed_manifold"], true);
+
+    // Odd budgets and non-manifold inputs: one line, no output file.
+    let refused = dir.path().join("refused.obj");
+    for args in [
+        vec![
+            "decimate",
+            init.to_str().unwrap(),
+            "-o",
+            refused.to_str().unwrap(),
+            "--faces",
+            "201",
+        ],
+        vec![
+            "decimate",
+            soup.to_str().unwrap(),
+            "-o",
+            refused.to_str().unwrap(),
+            "--faces",
+            "200",
+        ],
+        vec![
+            "init",
+            soup.to_str().unwrap(),
+            "-o",
+            refused.to_str().unwrap(),
+            "--faces",
+            "7",
+        ],
+        vec![
+            "reconstruct",
+            soup.to_str().unwrap(),
+            "-o",
+            refused.to_str().unwrap(),
+            "--faces",
+            "999",
+        ],
+    ] {
+        let output = roar(&args);
+        assert_one_line_error(&output, &args.join(" "));
+        assert!(!refused.exists(), "{}: no partial output", args.join(" "));
+    }
+}

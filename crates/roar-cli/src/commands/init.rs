@@ -6,9 +6,7 @@ use std::path::PathBuf;
 
 use anyhow::Context;
 use clap::Args;
-use roar_mesh::Mesh;
-use roar_ops::init::{InitOptions, watertight_init};
-use roar_ops::qem::{DecimateOptions, decimate};
+use roar_ops::init::{InitOptions, InitialMeshOptions, initial_mesh};
 
 use crate::input::{check_even_budget, welded_referenced, write_mesh};
 
@@ -33,30 +31,24 @@ pub fn run(args: &InitArgs) -> anyhow::Result<()> {
     check_even_budget(args.faces)?;
     let soup = roar_io::read_mesh(&args.input)?;
     let (positions, triangles) = welded_referenced(&soup);
-    let options = InitOptions {
-        resolution: args.resolution,
-        ..InitOptions::default()
+    let options = InitialMeshOptions {
+        init: InitOptions {
+            resolution: args.resolution,
+            ..InitOptions::default()
+        },
+        max_faces: args.faces,
+        ..InitialMeshOptions::default()
     };
-    let init = watertight_init(&positions, &triangles, &options)
+    let (mesh, stats) = initial_mesh(&positions, &triangles, &options)
         .with_context(|| format!("{}: watertight init failed", args.input.display()))?;
-    let mut mesh = Mesh::from_triangles(init.positions, &init.triangles)
-        .context("internal: the watertight init is not a closed manifold")?;
-    let voxel_faces = mesh.n_faces();
-    if mesh.n_faces() > args.faces {
-        let options = DecimateOptions {
-            best_effort: true,
-            ..DecimateOptions::default()
-        };
-        decimate(&mut mesh, args.faces, &options)?;
-    }
     write_mesh(&args.output, &mesh)?;
     eprintln!(
         "wrote {}: {} faces ({} before decimation), {} piece(s), {} dropped, genus {}",
         args.output.display(),
         mesh.n_faces(),
-        voxel_faces,
-        init.stats.pieces,
-        init.stats.dropped_pieces,
+        stats.init_faces,
+        stats.init.pieces,
+        stats.init.dropped_pieces,
         mesh.genus()
     );
     Ok(())

@@ -112,7 +112,11 @@ pub fn run(args: &ReconstructArgs) -> anyhow::Result<()> {
     let result = result?;
 
     let out_soup = roar_io::TriangleSoup::new(result.positions, result.triangles);
-    let eval_input = EvalOptions::default();
+    // Soups can be large and their self-intersections are not what the report is about.
+    let eval_input = EvalOptions {
+        self_intersections: None,
+        ..EvalOptions::default()
+    };
     let input_metrics = roar_eval::evaluate(&soup.positions, &soup.triangles, None, &eval_input)?;
     let output_metrics = roar_eval::evaluate(
         &out_soup.positions,

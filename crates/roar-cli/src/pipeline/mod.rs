@@ -27,7 +27,7 @@ use roar_loss::{
 use roar_mesh::{EdgeId, Mesh};
 use roar_ops::block::{Block, BlockContext, BlockStats};
 use roar_ops::collapse_block::{FaceCollapse, FaceCollapseOptions};
-use roar_ops::init::{InitError, InitOptions, watertight_init};
+use roar_ops::init::{InitError, InitOptions, InitialMeshOptions};
 use roar_ops::optim::{Optimizer, OptimizerOptions};
 use roar_ops::qem::{DecimateError, DecimateOptions, DecimateStats, decimate};
 use roar_ops::smoothing::TangentialSmoothing;
@@ -391,35 +391,30 @@ fn initial_mesh(
     config: &ReconstructConfig,
     stats: &mut RunStats,
 ) -> Result<Mesh, PipelineError> {
-    let mut mesh = match config.init {
+    let mesh = match config.init {
         InitKind::Watertight => {
-            let init = watertight_init(
-                &target.positions,
-                &target.triangles,
-                &InitOptions {
+            let options = InitialMeshOptions {
+                init: InitOptions {
                     resolution: config.init_resolution,
                     ..InitOptions::default()
                 },
-            )?;
-            Mesh::from_triangles(init.positions, &init.triangles)
-                .map_err(|e| PipelineError::Internal(format!("watertight init: {e}")))?
+                max_faces: config.init_max_faces,
+                ..InitialMeshOptions::default()
+            };
+            let (mesh, init_stats) =
+                roar_ops::init::initial_mesh(&target.positions, &target.triangles, &options)?;
+            stats.init_voxel_faces = init_stats.init_faces;
+            mesh
         }
         InitKind::Sphere => {
             let mut sphere = roar_mesh::shapes::icosphere(config.sphere_level);
             for p in sphere.positions_mut() {
                 *p *= 0.5;
             }
+            stats.init_voxel_faces = sphere.n_faces();
             sphere
         }
     };
-    stats.init_voxel_faces = mesh.n_faces();
-    if mesh.n_faces() > config.init_max_faces {
-        let options = DecimateOptions {
-            best_effort: true,
-            ..DecimateOptions::default()
-        };
-        decimate(&mut mesh, config.init_max_faces, &options)?;
-    }
     stats.init_faces = mesh.n_faces();
     stats.init_components = mesh.components().0;
     stats.init_genus = mesh.genus();
