@@ -1,0 +1,67 @@
+//! The pipeline at toy settings (few views, low resolution, few iterations), fast enough for the
+//! default test run: its promises hold and it is deterministic.
+
+use roar_cli::pipeline::{InitKind, ReconstructConfig, Reconstruction};
+use roar_mesh::Mesh;
+use roar_mesh::spatial::self_intersecting_faces;
+
+fn toy_config(faces: usize) -> ReconstructConfig {
+    ReconstructConfig {
+        faces,
+        iterations: 6,
+        init_resolution: 32,
+        init_max_faces: 4000,
+        working_budget_min: 600,
+        views_per_axis: 2,
+        render_resolution: 64,
+        point_cloud_samples: 5000,
+        sharp_edge_samples: 1000,
+        planar_max_samples: 5000,
+        split_interval: 3,
+        smoothing_interval: 2,
+        ..ReconstructConfig::default()
+    }
+}
+
+fn run(config: ReconstructConfig) -> (Vec<glam::DVec3>, Vec<[u32; 3]>, usize) {
+    let soup = roar_cli::example::chair_soup();
+    let mut stages = Vec::new();
+    let out = Reconstruction::new(config)
+        .run(&soup.positions, &soup.triangles, &mut |p| {
+            stages.push(p.stage)
+        })
+        .unwrap();
+    for stage in ["target", "init", "optimize", "decimate"] {
+        assert!(stages.contains(&stage), "progress never reported {stage}");
+    }
+    (out.positions, out.triangles, out.stats.init_components)
+}
+
+#[test]
+fn toy_reconstruction_is_closed_exact_and_intersection_free() {
+    for init in [InitKind::Watertight, InitKind::Sphere] {
+        let (positions, triangles, init_components) = run(ReconstructConfig {
+            init,
+            ..toy_config(300)
+        });
+        assert_eq!(triangles.len(), 300, "{init:?}");
+        let mesh = Mesh::from_triangles(positions.clone(), &triangles).unwrap();
+        mesh.validate().unwrap();
+        assert!(mesh.signed_volume() > 0.0);
+        assert!(mesh.components().0 <= init_components);
+        assert!(!self_intersecting_faces(&positions, &triangles).contains(&true));
+    }
+}
+
+#[test]
+fn same_input_config_and_seed_give_the_same_bits() {
+    let a = run(toy_config(200));
+    let b = run(toy_config(200));
+    assert_eq!(a.1, b.1);
+    let bits = |p: &[glam::DVec3]| {
+        p.iter()
+            .flat_map(|v| v.to_array().map(f64::to_bits))
+            .collect::<Vec<_>>()
+    };
+    assert_eq!(bits(&a.0), bits(&b.0));
+}
