@@ -24,13 +24,14 @@
 mod collapse;
 mod exact;
 mod limiter;
+mod pairs;
 mod resolve;
 mod separate;
 
 pub use limiter::{LimiterOptions, LimiterStats, limit_steps};
 
 use collapse::{Buffers, quality, try_collapse_face};
-use roar_mesh::spatial::{Aabb, TriangleBvh, intersecting_pairs};
+use roar_mesh::spatial::{Aabb, TriangleBvh};
 use roar_mesh::{FaceId, Mesh};
 use std::collections::BTreeSet;
 
@@ -98,8 +99,9 @@ pub struct UntangleStats {
 /// the topology (genus and piece count are kept); a mesh without intersections is left
 /// bit-for-bit unchanged; at most `max_rounds` rounds run, and every face still intersecting
 /// (or within the margin of a formerly crossing face) at the end is listed in
-/// `unresolved_faces`. Cost per round: one BVH self-intersection query, one fast-winding-number
-/// build and two O(log F) probes per examined vertex.
+/// `unresolved_faces`. Cost: one full BVH self-intersection query at the start (and after each
+/// round with collapses); then per round a BVH refit, exact tests for the faces that moved, one
+/// fast-winding-number build and two O(log F) probes per examined vertex.
 pub fn untangle(mesh: &mut Mesh, options: &UntangleOptions) -> UntangleStats {
     let mut stats = UntangleStats::default();
     let mut buffers = Buffers::from_mesh(mesh);
@@ -111,8 +113,9 @@ pub fn untangle(mesh: &mut Mesh, options: &UntangleOptions) -> UntangleStats {
     let mut crossing_rounds = vec![0usize; mesh.face_capacity()];
     let mut remaining: Vec<(u32, u32)> = Vec::new();
     let mut moved = false;
+    let mut finder = pairs::PairFinder::default();
     for round in 0..=options.max_rounds {
-        let pairs = intersecting_pairs(&buffers.positions, &buffers.triangles);
+        let pairs = finder.find(&buffers.positions, &buffers.triangles);
         if round == 0 {
             stats.initial_pairs = pairs.len();
         }
@@ -161,6 +164,7 @@ pub fn untangle(mesh: &mut Mesh, options: &UntangleOptions) -> UntangleStats {
                 let applied = collapse_some(mesh, &mut buffers, &candidates, options);
                 if applied > 0 {
                     stats.collapses += applied;
+                    finder.invalidate();
                     crossing_rounds.iter_mut().for_each(|c| *c = 0);
                     continue; // re-detect the pairs on the new topology
                 }
