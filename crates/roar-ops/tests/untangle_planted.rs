@@ -127,6 +127,8 @@ fn step_limiter_blocks_a_step_through_the_opposite_wall() {
 }
 
 /// Release timing: `cargo test --release -p roar-ops --test untangle_planted -- --ignored --nocapture`.
+/// The limiter sees a typical optimizer step: every vertex moves 5 % of the mean edge length in
+/// a pseudo-random direction; the best of 5 calls is reported.
 #[test]
 #[ignore]
 fn timing_limiter_10k_and_untangle() {
@@ -134,21 +136,41 @@ fn timing_limiter_10k_and_untangle() {
     let half = roar_mesh::shapes::torus(100, 50, 1.0, 0.3); // 10 000 faces
     for (label, mesh) in [("torus 10k", half), ("icosphere 20k", m)] {
         let (before, t) = mesh.to_triangles();
+        let mean_edge =
+            mesh.edges().map(|e| mesh.edge_length(e)).sum::<f64>() / mesh.n_edges() as f64;
         let start = std::time::Instant::now();
         let bvh = TriangleBvh::build(&before, &t);
         let build = start.elapsed();
-        let mut proposed: Vec<DVec3> = before
-            .iter()
-            .enumerate()
-            .map(|(i, p)| *p + 0.002 * DVec3::new((i % 5) as f64 - 2.0, (i % 3) as f64 - 1.0, 0.5))
+        let step: Vec<DVec3> = (0..before.len())
+            .map(|i| {
+                let h = |k: usize| ((i * 7919 + k * 104_729) % 1000) as f64 / 500.0 - 1.0;
+                DVec3::new(h(1), h(2), h(3)).normalize_or(DVec3::X) * 0.05 * mean_edge
+            })
             .collect();
-        let start = std::time::Instant::now();
-        let stats = limit_steps(&before, &mut proposed, &t, &bvh, &LimiterOptions::default());
-        println!(
-            "{label}: bvh {build:.2?}, limit_steps {:.2?}, {stats:?}",
-            start.elapsed()
-        );
+        let mut best = std::time::Duration::MAX;
+        let mut stats = None;
+        for _ in 0..5 {
+            let mut proposed: Vec<DVec3> = before.iter().zip(&step).map(|(p, s)| *p + *s).collect();
+            let start = std::time::Instant::now();
+            stats = Some(limit_steps(
+                &before,
+                &mut proposed,
+                &t,
+                &bvh,
+                &LimiterOptions::default(),
+            ));
+            best = best.min(start.elapsed());
+            assert!(intersecting_pairs(&proposed, &t).is_empty());
+        }
+        println!("{label}: bvh {build:.2?}, limit_steps best of 5 {best:.2?}, {stats:?}");
     }
     check_untangled(two_spheres(4), "two spheres level 4");
     check_untangled(dented_disc(4), "dented disc level 4");
+    let start = std::time::Instant::now();
+    let (p, t) = two_spheres(4).to_triangles();
+    let n = intersecting_pairs(&p, &t).len();
+    println!(
+        "one intersecting_pairs on two spheres level 4: {:.2?} ({n} pairs)",
+        start.elapsed()
+    );
 }
