@@ -77,6 +77,9 @@ pub struct ReconstructConfig {
     pub split_threshold: f64,
     /// Tangential smoothing every this many iterations (§1.3, OQ-13: 5; 0 = off).
     pub smoothing_interval: usize,
+    /// Shorten optimizer steps that would make faces intersect (`roar_ops::untangle::limit_steps`),
+    /// so the loop itself keeps the mesh intersection-free where the blocks did.
+    pub step_limiter: bool,
     /// Separation margin of the untangle block, relative to the bounding-box diagonal.
     pub untangle_margin: f64,
     /// Write the closest mesh when the final QEM cannot reach the budget, instead of failing.
@@ -115,6 +118,7 @@ impl Default for ReconstructConfig {
             split_interval: 10,
             split_threshold: 0.02,
             smoothing_interval: 5,
+            step_limiter: true,
             untangle_margin: 1e-6,
             best_effort: false,
         }

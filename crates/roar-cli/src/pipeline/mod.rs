@@ -24,6 +24,7 @@ use roar_loss::{
     PointCloudOptions, RenderLoss, SharpEdgeOptions, Target, TargetOptions, WeightedSum,
     build_target, point_cloud, sharp_edge_samples,
 };
+use roar_mesh::spatial::TriangleBvh;
 use roar_mesh::{EdgeId, Mesh};
 use roar_ops::block::{Block, BlockContext, BlockStats};
 use roar_ops::collapse_block::{FaceCollapse, FaceCollapseOptions};
@@ -32,7 +33,7 @@ use roar_ops::optim::{Optimizer, OptimizerOptions};
 use roar_ops::qem::{DecimateError, DecimateOptions, DecimateStats, decimate};
 use roar_ops::smoothing::TangentialSmoothing;
 use roar_ops::split_block::{FaceSplit, FaceSplitOptions, SplitThreshold};
-use roar_ops::untangle::{UntangleOptions, UntangleStats, untangle};
+use roar_ops::untangle::{LimiterOptions, UntangleOptions, UntangleStats, limit_steps, untangle};
 use serde::Serialize;
 
 pub use config::{InitKind, ReconstructConfig};
@@ -130,6 +131,8 @@ pub struct RunStats {
     pub loop_faces: usize,
     /// Accepted operations per block over the loop, by block name.
     pub block_accepted: BTreeMap<&'static str, usize>,
+    /// Vertex steps the step limiter shortened or cancelled over the loop.
+    pub steps_shortened: usize,
     /// Edge splits used to fill up to N.
     pub fill_splits: usize,
     /// Untangle statistics.
@@ -260,10 +263,23 @@ impl Reconstruction {
             stats.loss_last = value;
             stats.history.push((value, mesh.n_faces()));
             clock.lap("loop_loss");
+            let before = config.step_limiter.then(|| mesh.positions().to_vec());
             optimizer
                 .step(mesh.positions_mut(), &triangles, &gradient)
                 .map_err(|e| PipelineError::Internal(e.to_string()))?;
             clock.lap("loop_step");
+            if let Some(before) = before {
+                let bvh = TriangleBvh::build(&before, &triangles);
+                let limited = limit_steps(
+                    &before,
+                    mesh.positions_mut(),
+                    &triangles,
+                    &bvh,
+                    &LimiterOptions::default(),
+                );
+                stats.steps_shortened += limited.shortened + limited.cancelled;
+                clock.lap("loop_step_limiter");
+            }
             let context = BlockContext {
                 iteration,
                 face_budget: budget,
