@@ -36,13 +36,15 @@ def log(message):
 def error_text(stderr, returncode):
     """The user-facing part of a failed command's stderr, on one line."""
     lines = [line.strip() for line in stderr.splitlines() if line.strip()]
-    start = next((i for i, line in enumerate(lines) if line.startswith("Error:")), None)
+    # roar prints its whole error chain as one `roar: error: ...` line.
+    start = next((i for i, line in enumerate(lines) if line.startswith("roar: error:")), None)
     if start is not None:
-        lines = lines[start:]
+        lines = [lines[start][len("roar: error:"):].strip()]
     elif lines:
-        lines = lines[-3:]  # a Python traceback: its last lines name the exception
+        lines = lines[-1:]  # a Python traceback or a crash: its last line names the exception
     text = " / ".join(lines) if lines else "no message"
-    return "exit %s: %s" % (returncode, text[:400])
+    status = "killed by signal %d" % -returncode if returncode < 0 else "exit %d" % returncode
+    return "%s: %s" % (status, text[:400])
 
 
 def run(cmd, timeout, log_path):
@@ -284,7 +286,7 @@ def main():
     parser.add_argument("--roar", required=True, help="the roar binary")
     parser.add_argument("--python", required=True, help="python of the peers' virtualenv")
     parser.add_argument("--data", required=True, help="folder of input meshes")
-    parser.add_argument("--meshes", default="*", help="glob of file names inside --data")
+    parser.add_argument("--meshes", default="*", help="space-separated globs of file names inside --data (or paths)")
     parser.add_argument("--budgets", default="1000 5000")
     parser.add_argument("--iterations", type=int, default=None)
     parser.add_argument("--samples", type=int, default=50000)
@@ -299,10 +301,10 @@ def main():
     if unknown:
         parser.error("unknown methods %s (known: %s)" % (unknown, " ".join(METHODS)))
 
-    pattern = args.meshes if os.sep in args.meshes else os.path.join(args.data, args.meshes)
-    meshes = sorted(p for p in glob.glob(pattern) if os.path.isfile(p))
+    patterns = [p if os.sep in p else os.path.join(args.data, p) for p in args.meshes.split()]
+    meshes = sorted({p for pattern in patterns for p in glob.glob(pattern) if os.path.isfile(p)})
     if not meshes:
-        sys.exit("no mesh matches %s" % pattern)
+        sys.exit("no mesh matches %s" % " ".join(patterns))
     os.makedirs(args.out, exist_ok=True)
     results = {
         "started": datetime.datetime.now().isoformat(timespec="seconds"),

@@ -4,7 +4,7 @@
 # `roar eval --ref RAW_INPUT`, and writes DIR/table.md and DIR/results.json.
 # How to run it and read the table: docs/evaluation.md.
 #
-#   scripts/evaluate.sh [--budgets "1000 5000"] [--meshes GLOB] [--iterations K] [--out DIR]
+#   scripts/evaluate.sh [--budgets "1000 5000"] [--meshes "GLOB ..."] [--iterations K] [--out DIR]
 #                       [--samples S] [--timeout SECONDS] [--methods "roar roar-init+qem ..."]
 #
 # Inputs: $ROAR_TEST_DATA/wild (default ROAR_TEST_DATA: ../shared/data/meshes beside the repo).
