@@ -221,7 +221,8 @@ def summary(results, budget):
                    if str(budget) in meshes[m].get(method, {})]
         out["median_seconds_" + method] = median_or_none(
             [e.get("seconds") for e in entries if "error" not in e])
-        out["failures_" + method] = sum(1 for e in entries if "error" in e)
+        # None (printed n/a) when the method was not run at all (--methods).
+        out["failures_" + method] = sum(1 for e in entries if "error" in e) if entries else None
     return out
 
 
@@ -263,7 +264,7 @@ def write_table(results, path):
         lines.append("- median seconds: " + ", ".join(
             "%s %s" % (m, fmt(s["median_seconds_" + m], "s")) for m in METHODS))
         lines.append("- failures: " + ", ".join(
-            "%s %d" % (m, s["failures_" + m]) for m in METHODS))
+            "%s %s" % (m, fmt(s["failures_" + m], "int")) for m in METHODS))
     lines.append("")
     tmp = path + ".tmp"
     with open(tmp, "w") as f:
