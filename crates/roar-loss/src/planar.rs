@@ -8,13 +8,13 @@
 //! face's three vertices through its barycentric weights.
 
 use glam::DVec3;
-use kiddo::SquaredEuclidean;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
 use roar_mesh::spatial::{RegularSamples, RegularSamplingOptions, regular_samples};
 
-use crate::knn_projector::{KnnOptions, KnnPlanarProjector, build_tree};
+use crate::knn_projector::{KnnOptions, KnnPlanarProjector};
+use crate::point_tree::PointTree;
 use crate::{Loss, LossError};
 
 /// Target points per parallel work item of the t2s assignment.
@@ -251,8 +251,8 @@ pub fn combine_moves(s2t: &[Option<DVec3>], t2s: &[Option<DVec3>]) -> Vec<Option
 }
 
 /// The target→source term (spec §3.2.2 t2s): every target point is assigned to its nearest
-/// sample (kd-tree over the samples, ties to the smaller sample index via the tree's fixed
-/// order); each sample takes its farthest assigned point `t*` (ties: smaller target index) and,
+/// sample (f32 kd-tree over the samples, ties to the smaller sample index; the assigned
+/// distance is recomputed in f64); each sample takes its farthest assigned point `t*` (ties: smaller target index) and,
 /// if `m_{t*}·n_i ≥ normal_dot`, the along-normal intersection with the plane `(t*, m_{t*})`.
 /// The blow-up guard of s2t is not applied (the 0.95 gate bounds the move). `None` for samples
 /// with no assigned point, a failed gate, or non-finite input.
@@ -271,13 +271,12 @@ pub fn t2s_moves(
         return result;
     }
     let finite_points: Vec<DVec3> = finite.iter().map(|&i| samples[i]).collect();
-    let tree = build_tree(&finite_points);
+    let tree = PointTree::new(&finite_points);
     let assign = |t: &DVec3| -> Option<(u32, f64)> {
         if !t.is_finite() {
             return None;
         }
-        let nn = tree.nearest_one::<SquaredEuclidean>(&t.to_array());
-        let i = finite[nn.item as usize];
+        let i = finite[tree.nearest_one(*t)? as usize];
         Some((i as u32, samples[i].distance_squared(*t)))
     };
     let assigned: Vec<Option<(u32, f64)>> = if target_points.len() <= CHUNK {
