@@ -132,6 +132,11 @@ impl KnnPlanarProjector {
         &self.normals
     }
 
+    /// Target point indices in a spatially coherent order (the kd-tree's leaf order).
+    pub(crate) fn spatial_order(&self) -> &[u32] {
+        self.tree.spatial_order()
+    }
+
     /// The `k` nearest target points of `p` as `(index, squared distance)`, sorted by distance
     /// then index (distances recomputed in f64, so the order is exact; the set is searched in
     /// f32 and can differ from the exact one only at near-ties, within f32 precision). Fewer when

@@ -10,7 +10,7 @@
 use glam::DVec3;
 
 /// Points per leaf: small enough to prune well, large enough to amortize the descent.
-const LEAF_SIZE: usize = 12;
+const LEAF_SIZE: usize = 16;
 
 /// `Node::axis` value of a leaf.
 const LEAF: u8 = 3;
@@ -39,18 +39,26 @@ struct Node {
 #[derive(Debug, Clone, Default)]
 pub(crate) struct PointTree {
     nodes: Vec<Node>,
-    /// Point coordinates in tree order (each leaf's points are contiguous).
-    coords: Vec<[f32; 3]>,
+    /// Point coordinates in tree order, one array per axis (each leaf's points are contiguous,
+    /// so a leaf's distances compute in SIMD lanes).
+    xs: Vec<f32>,
+    ys: Vec<f32>,
+    zs: Vec<f32>,
     /// Input index of each point in tree order.
     ids: Vec<u32>,
+    /// Point coordinates in input order (to turn a previous answer into a search bound).
+    coords_by_id: Vec<[f32; 3]>,
 }
 
 /// The best neighbours of one query, sorted by (squared distance, index); a reusable buffer so
-/// queries do not allocate.
+/// queries do not allocate. The previous answer also seeds the next query's search bound
+/// (consecutive queries are usually close), which changes the work, never the answer.
 #[derive(Debug, Clone, Default)]
 pub(crate) struct Neighbours {
     items: Vec<(f32, u32)>,
     k: usize,
+    /// Squared distance within which at least `k` points are known to lie (∞ if unknown).
+    limit: f32,
 }
 
 impl Neighbours {
@@ -60,17 +68,20 @@ impl Neighbours {
         &self.items
     }
 
-    /// Clears the buffer for a query of `k` neighbours.
-    fn reset(&mut self, k: usize) {
+    /// Clears the buffer for a query of `k` neighbours known to lie within squared distance
+    /// `limit`.
+    fn reset(&mut self, k: usize, limit: f32) {
         self.items.clear();
         self.k = k;
+        self.limit = limit;
     }
 
-    /// The squared distance a point must not exceed to enter (∞ until `k` are found).
+    /// The squared distance a point must not exceed to enter: the limit until `k` are found,
+    /// then the current `k`-th distance (never above the limit).
     #[inline]
     fn bound(&self) -> f32 {
         if self.items.len() < self.k {
-            f32::INFINITY
+            self.limit
         } else {
             self.items[self.k - 1].0
         }
@@ -126,9 +137,18 @@ impl PointTree {
         if !entries.is_empty() {
             tree.build(&mut entries, 0);
         }
-        tree.coords = entries.iter().map(|e| e.0).collect();
+        tree.xs = entries.iter().map(|e| e.0[0]).collect();
+        tree.ys = entries.iter().map(|e| e.0[1]).collect();
+        tree.zs = entries.iter().map(|e| e.0[2]).collect();
+        tree.coords_by_id = points.iter().map(|&p| to_f32(p)).collect();
         tree.ids = entries.iter().map(|e| e.1).collect();
         tree
+    }
+
+    /// Input indices in tree order: a spatially coherent visiting order (points of a leaf are
+    /// adjacent), which makes the hints of consecutive queries tight.
+    pub(crate) fn spatial_order(&self) -> &[u32] {
+        &self.ids
     }
 
     /// Appends the subtree over `entries` (tree positions from `start`) and returns its index.
@@ -178,21 +198,40 @@ impl PointTree {
 
     /// Fills `found` with the `k` nearest points of `query` (fewer if the tree is smaller),
     /// sorted by (f32 squared distance, index). `k = 0` or an empty tree gives nothing.
+    /// `found`'s previous answer (any `k` distinct points of this tree) bounds the search.
     pub(crate) fn nearest_n(&self, query: DVec3, k: usize, found: &mut Neighbours) {
-        found.reset(k);
+        let q = to_f32(query);
+        let mut limit = f32::INFINITY;
+        if k > 0 && found.items.len() == k {
+            // The previous k neighbours all lie within `limit` of the new query.
+            limit = 0.0;
+            for &(_, id) in &found.items {
+                match self.coords_by_id.get(id as usize) {
+                    Some(c) => limit = limit.max(distance2(c, &q)),
+                    None => limit = f32::INFINITY,
+                }
+            }
+        }
+        found.reset(k, limit);
         if k == 0 || self.nodes.is_empty() {
             return;
         }
-        self.search(0, &to_f32(query), [0.0; 3], 0.0, found);
+        self.search(0, &q, [0.0; 3], 0.0, found);
     }
 
-    /// The nearest point of `query` (ties: smaller index); `None` for an empty tree.
-    pub(crate) fn nearest_one(&self, query: DVec3) -> Option<u32> {
+    /// The nearest point of `query` (ties: smaller index); `None` for an empty tree. `hint`, a
+    /// point of this tree (e.g. the previous answer), bounds the search.
+    pub(crate) fn nearest_one(&self, query: DVec3, hint: Option<u32>) -> Option<u32> {
         if self.nodes.is_empty() {
             return None;
         }
-        let mut best = (f32::INFINITY, u32::MAX);
-        self.search_one(0, &to_f32(query), [0.0; 3], 0.0, &mut best);
+        let q = to_f32(query);
+        let limit = hint
+            .and_then(|id| self.coords_by_id.get(id as usize))
+            .map_or(f32::INFINITY, |c| distance2(c, &q));
+        // Starts at (limit, u32::MAX): the hint itself always qualifies, so `best` is filled.
+        let mut best = (limit, u32::MAX);
+        self.search_one(0, &q, [0.0; 3], 0.0, &mut best);
         Some(best.1)
     }
 
@@ -201,8 +240,9 @@ impl PointTree {
         let nd = self.nodes[node as usize];
         if nd.axis == LEAF {
             let (start, end) = (nd.start as usize, nd.end as usize);
-            for (c, &id) in self.coords[start..end].iter().zip(&self.ids[start..end]) {
-                let d2 = distance2(c, q);
+            let mut d2 = [0.0; LEAF_SIZE];
+            let d2 = self.leaf_distances(nd, q, &mut d2);
+            for (&d2, &id) in d2.iter().zip(&self.ids[start..end]) {
                 if d2 < best.0 || (d2 == best.0 && id < best.1) {
                     *best = (d2, id);
                 }
@@ -225,13 +265,36 @@ impl PointTree {
         }
     }
 
+    /// Squared distances from `q` to the points of leaf `leaf`, written to the front of `out`.
+    #[inline]
+    fn leaf_distances<'a>(
+        &self,
+        leaf: Node,
+        q: &[f32; 3],
+        out: &'a mut [f32; LEAF_SIZE],
+    ) -> &'a [f32] {
+        let (start, end) = (leaf.start as usize, leaf.end as usize);
+        let out = &mut out[..end - start];
+        let (xs, ys, zs) = (
+            &self.xs[start..end],
+            &self.ys[start..end],
+            &self.zs[start..end],
+        );
+        for i in 0..out.len() {
+            let (dx, dy, dz) = (xs[i] - q[0], ys[i] - q[1], zs[i] - q[2]);
+            out[i] = dx * dx + dy * dy + dz * dz;
+        }
+        out
+    }
+
     /// Visits `node` whose cell lies at squared distance `rd` (per-axis offsets `off`).
     fn search(&self, node: u32, q: &[f32; 3], off: [f32; 3], rd: f32, found: &mut Neighbours) {
         let nd = self.nodes[node as usize];
         if nd.axis == LEAF {
             let (start, end) = (nd.start as usize, nd.end as usize);
-            for (c, &id) in self.coords[start..end].iter().zip(&self.ids[start..end]) {
-                let d2 = distance2(c, q);
+            let mut d2 = [0.0; LEAF_SIZE];
+            let d2 = self.leaf_distances(nd, q, &mut d2);
+            for (&d2, &id) in d2.iter().zip(&self.ids[start..end]) {
                 if d2 <= found.bound() {
                     found.offer(d2, id);
                 }
@@ -288,7 +351,9 @@ mod tests {
                 p.z = 0.25;
             }
             let tree = PointTree::new(&points);
+            // One buffer across queries and k: the previous answer seeds each search bound.
             let mut found = Neighbours::default();
+            let mut previous = None;
             for _ in 0..50 {
                 let q = DVec3::new(rng.random(), rng.random(), rng.random()) * 2.4 - DVec3::ONE;
                 for k in [1, 10, 40] {
@@ -299,11 +364,14 @@ mod tests {
                         "n {n} k {k}"
                     );
                 }
-                assert_eq!(
-                    tree.nearest_one(q),
-                    Some(brute(&points, q, 1)[0].1),
-                    "nearest one, n {n}"
-                );
+                for hint in [None, previous, Some(0)] {
+                    assert_eq!(
+                        tree.nearest_one(q, hint),
+                        Some(brute(&points, q, 1)[0].1),
+                        "nearest one, n {n}"
+                    );
+                }
+                previous = tree.nearest_one(q, None);
             }
         }
     }
@@ -311,7 +379,7 @@ mod tests {
     #[test]
     fn empty_tree_and_zero_k_give_nothing() {
         let tree = PointTree::new(&[]);
-        assert_eq!(tree.nearest_one(DVec3::ZERO), None);
+        assert_eq!(tree.nearest_one(DVec3::ZERO, Some(3)), None);
         let tree = PointTree::new(&[DVec3::X]);
         let mut found = Neighbours::default();
         tree.nearest_n(DVec3::ZERO, 0, &mut found);
