@@ -7,7 +7,8 @@
 //! Run: `cargo run --release -p roar-loss --example planar_profile [P] [iterations]`, or under
 //! `valgrind --tool=callgrind` with one iteration (instruction counts are repeatable on a
 //! shared machine, wall times are not; one evaluation costs the difference between runs with
-//! 2 and 1 iterations). Env `PHASES=1` adds a per-phase wall-time breakdown.
+//! 2 and 1 iterations). Env `PHASES=1` adds a per-phase wall-time breakdown, `CAP_STUDY=1` the
+//! gradient error of smaller sample caps against the uncapped loss.
 
 use std::time::Instant;
 
@@ -57,6 +58,9 @@ fn main() {
     );
     println!("stats: {:?}", loss.last_stats);
     println!("checksum {checksum:.12e}");
+    if std::env::var_os("CAP_STUDY").is_some() {
+        cap_study(&cloud.points, &cloud.normals, &sp, &st);
+    }
     if std::env::var_os("PHASES").is_some() {
         phases(&loss, &sp, &st);
     }
@@ -93,4 +97,38 @@ fn phases(loss: &PlanarLoss, sp: &[DVec3], st: &[[u32; 3]]) {
     );
     report("t2s");
     println!("  ({} s2t, {} t2s moves)", s2t.len(), t2s.len());
+}
+
+/// Relative L2 gradient error and loss error of capped evaluations against uncapped ones (other
+/// seeds), next to the uncapped seed-to-seed spread (the floor set by the grid rounding).
+fn cap_study(points: &[DVec3], normals: &[DVec3], sp: &[DVec3], st: &[[u32; 3]]) {
+    let evaluate = |cap: usize, seed: u64| {
+        let options = PlanarOptions {
+            max_samples: cap,
+            seed,
+            ..PlanarOptions::default()
+        };
+        let mut loss = PlanarLoss::new(points, normals, &options).expect("valid cloud");
+        let start = Instant::now();
+        let (value, grad) = loss.value_and_grad(sp, st).expect("valid mesh");
+        (value, grad, start.elapsed().as_secs_f64() * 1e3)
+    };
+    let references: Vec<_> = (100..103).map(|seed| evaluate(usize::MAX, seed)).collect();
+    let norm = |g: &[DVec3]| g.iter().map(|g| g.length_squared()).sum::<f64>().sqrt();
+    let error = |a: &(f64, Vec<DVec3>, f64), b: &(f64, Vec<DVec3>, f64)| {
+        let diff: Vec<DVec3> = a.1.iter().zip(&b.1).map(|(x, y)| *x - *y).collect();
+        (norm(&diff) / norm(&b.1), (a.0 - b.0).abs() / b.0)
+    };
+    println!("cap | grad rel. err (mean over 3 refs) | loss rel. err | ms");
+    for cap in [usize::MAX, 200_000, 100_000, 50_000, 25_000, 12_500] {
+        let (mut ge, mut le, mut ms) = (0.0, 0.0, 0.0);
+        for (r, seed) in references.iter().zip([7u64, 8, 9]) {
+            let run = evaluate(cap, seed);
+            let (g, l) = error(&run, r);
+            ge += g / 3.0;
+            le += l / 3.0;
+            ms += run.2 / 3.0;
+        }
+        println!("{cap:>8} | {ge:.4} | {le:.2e} | {ms:.0}");
+    }
 }

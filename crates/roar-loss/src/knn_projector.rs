@@ -262,9 +262,12 @@ pub fn planar_move(
         if cos.is_nan() || cos <= options.normal_dot_threshold {
             continue;
         }
-        let alpha = (t - s).dot(m) / cos;
+        let to_t = t - s;
+        let alpha = to_t.dot(m) / cos;
         let along = alpha * n;
-        let guard = (t - (s + along)).length() < options.blowup_guard * (t - s).length();
+        // |t − (s + along)| < guard·|t − s|, squared (both sides are non-negative).
+        let guard2 = options.blowup_guard * options.blowup_guard;
+        let guard = (to_t - along).length_squared() < guard2 * to_t.length_squared();
         if !guard || !along.is_finite() {
             continue;
         }
@@ -275,7 +278,7 @@ pub fn planar_move(
                 weight_sum += w;
             }
             PlanarMode::Orthogonal => {
-                weighted += w * (t - s).dot(m) * m;
+                weighted += w * to_t.dot(m) * m;
                 weight_sum += w;
             }
             PlanarMode::Nearest => {

@@ -12,6 +12,9 @@ use glam::DVec3;
 /// Points per leaf: small enough to prune well, large enough to amortize the descent.
 const LEAF_SIZE: usize = 16;
 
+/// Subtrees with at least this many points build their two halves in parallel.
+const PARALLEL_BUILD: usize = 16_384;
+
 /// `Node::axis` value of a leaf.
 const LEAF: u8 = 3;
 
@@ -110,6 +113,72 @@ impl Neighbours {
     }
 }
 
+/// Appends to `nodes` the subtree over `entries` (tree positions from `start`), in preorder
+/// with absolute child indices. Large halves are built in parallel into their own vectors and
+/// spliced in, which gives the same nodes as the serial recursion.
+fn build(entries: &mut [([f32; 3], u32)], start: usize, nodes: &mut Vec<Node>) {
+    let index = nodes.len();
+    let count = entries.len();
+    let mut node = Node {
+        start: start as u32,
+        end: (start + count) as u32,
+        axis: LEAF,
+        split: 0.0,
+        right: 0,
+    };
+    if count <= LEAF_SIZE {
+        nodes.push(node);
+        return;
+    }
+    let mut lo = [f32::INFINITY; 3];
+    let mut hi = [f32::NEG_INFINITY; 3];
+    for (c, _) in entries.iter() {
+        for a in 0..3 {
+            lo[a] = lo[a].min(c[a]);
+            hi[a] = hi[a].max(c[a]);
+        }
+    }
+    let extent = [hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]];
+    let axis = if extent[0] >= extent[1] && extent[0] >= extent[2] {
+        0
+    } else if extent[1] >= extent[2] {
+        1
+    } else {
+        2
+    };
+    let mid = count / 2;
+    entries.select_nth_unstable_by(mid, |a, b| {
+        a.0[axis].total_cmp(&b.0[axis]).then(a.1.cmp(&b.1))
+    });
+    node.axis = axis as u8;
+    node.split = entries[mid].0[axis];
+    nodes.push(node);
+    let (left, right) = entries.split_at_mut(mid);
+    if count < PARALLEL_BUILD {
+        build(left, start, nodes);
+        nodes[index].right = nodes.len() as u32;
+        build(right, start + mid, nodes);
+        return;
+    }
+    let subtree = |entries: &mut [([f32; 3], u32)], start: usize| {
+        let mut sub = Vec::with_capacity(2 * entries.len() / LEAF_SIZE + 1);
+        build(entries, start, &mut sub);
+        sub
+    };
+    let (left_nodes, right_nodes) =
+        rayon::join(|| subtree(left, start), || subtree(right, start + mid));
+    let right_index = index + 1 + left_nodes.len();
+    nodes[index].right = right_index as u32;
+    for (offset, sub) in [(index + 1, left_nodes), (right_index, right_nodes)] {
+        nodes.extend(sub.into_iter().map(|mut n| {
+            if n.axis != LEAF {
+                n.right += offset as u32;
+            }
+            n
+        }));
+    }
+}
+
 #[inline]
 fn to_f32(p: DVec3) -> [f32; 3] {
     [p.x as f32, p.y as f32, p.z as f32]
@@ -135,7 +204,7 @@ impl PointTree {
             ..Self::default()
         };
         if !entries.is_empty() {
-            tree.build(&mut entries, 0);
+            build(&mut entries, 0, &mut tree.nodes);
         }
         tree.xs = entries.iter().map(|e| e.0[0]).collect();
         tree.ys = entries.iter().map(|e| e.0[1]).collect();
@@ -149,51 +218,6 @@ impl PointTree {
     /// adjacent), which makes the hints of consecutive queries tight.
     pub(crate) fn spatial_order(&self) -> &[u32] {
         &self.ids
-    }
-
-    /// Appends the subtree over `entries` (tree positions from `start`) and returns its index.
-    fn build(&mut self, entries: &mut [([f32; 3], u32)], start: usize) -> u32 {
-        let index = self.nodes.len() as u32;
-        let count = entries.len();
-        let mut node = Node {
-            start: start as u32,
-            end: (start + count) as u32,
-            axis: LEAF,
-            split: 0.0,
-            right: 0,
-        };
-        if count <= LEAF_SIZE {
-            self.nodes.push(node);
-            return index;
-        }
-        let mut lo = [f32::INFINITY; 3];
-        let mut hi = [f32::NEG_INFINITY; 3];
-        for (c, _) in entries.iter() {
-            for a in 0..3 {
-                lo[a] = lo[a].min(c[a]);
-                hi[a] = hi[a].max(c[a]);
-            }
-        }
-        let extent = [hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]];
-        let axis = if extent[0] >= extent[1] && extent[0] >= extent[2] {
-            0
-        } else if extent[1] >= extent[2] {
-            1
-        } else {
-            2
-        };
-        let mid = count / 2;
-        entries.select_nth_unstable_by(mid, |a, b| {
-            a.0[axis].total_cmp(&b.0[axis]).then(a.1.cmp(&b.1))
-        });
-        node.axis = axis as u8;
-        node.split = entries[mid].0[axis];
-        self.nodes.push(node);
-        let (left, right) = entries.split_at_mut(mid);
-        self.build(left, start);
-        let right_index = self.build(right, start + mid);
-        self.nodes[index as usize].right = right_index;
-        index
     }
 
     /// Fills `found` with the `k` nearest points of `query` (fewer if the tree is smaller),
@@ -339,7 +363,8 @@ mod tests {
     #[test]
     fn matches_brute_force_in_f32_including_duplicates() {
         let mut rng = ChaCha8Rng::seed_from_u64(3);
-        for n in [1usize, 5, 13, 100, 2000] {
+        // 40 000 points exercise the parallel build.
+        for n in [1usize, 5, 13, 100, 2000, 40_000] {
             let mut points: Vec<DVec3> = (0..n)
                 .map(|_| DVec3::new(rng.random(), rng.random(), rng.random()) * 2.0 - DVec3::ONE)
                 .collect();
