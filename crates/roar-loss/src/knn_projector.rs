@@ -3,27 +3,23 @@
 //!
 //! Each sample `s` with unit normal `n` looks up its `k` nearest target points `t_j` (normals
 //! `m_j`), intersects the line `s + α n` with each neighbour's tangent plane, keeps the valid
-//! intersections and blends them with inverse-squared-distance weights. The kd-tree is built
-//! once over the target; queries run in parallel over fixed chunks and each answer depends only
-//! on its own sample, so results are bit-identical whatever the thread count.
+//! intersections and blends them with inverse-squared-distance weights. The kd-tree (f32, see
+//! [`crate::point_tree`]) is built once over the target; neighbour distances are recomputed in
+//! f64 and the plane projection runs in f64. Queries run in parallel over fixed chunks and each
+//! answer depends only on its own sample, so results are bit-identical whatever the thread count.
 
 use glam::DVec3;
-use kiddo::SquaredEuclidean;
-use kiddo::immutable::float::kdtree::ImmutableKdTree;
 use rayon::prelude::*;
 use roar_mesh::spatial::Projector;
-use std::num::NonZero;
 
 use crate::LossError;
+use crate::point_tree::{Neighbours, PointTree};
 
 /// Samples per parallel work item (coarse: the machine has few cores).
 const CHUNK: usize = 2048;
 
 /// Added to squared distances before inverting them into weights (spec §3.2.2 step 3).
 const WEIGHT_EPSILON: f64 = 1e-5;
-
-/// kd-tree over target points: f64 coordinates, `u32` items, bucket size 32.
-pub(crate) type PointTree = ImmutableKdTree<f64, u32, 3, 32>;
 
 /// How a sample's move is built from its valid neighbours (spec OQ-3 switches).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -94,12 +90,6 @@ pub(crate) fn check_cloud(points: &[DVec3], normals: &[DVec3]) -> Result<(), Los
     Ok(())
 }
 
-/// Builds the kd-tree over `points` (assumed checked by [`check_cloud`] or non-empty finite).
-pub(crate) fn build_tree(points: &[DVec3]) -> PointTree {
-    let coords: Vec<[f64; 3]> = points.iter().map(|p| p.to_array()).collect();
-    ImmutableKdTree::new_from_slice(&coords)
-}
-
 /// k-NN planar projector over a fixed oriented target point cloud (spec §3.4 (A)).
 #[derive(Debug, Clone)]
 pub struct KnnPlanarProjector {
@@ -120,7 +110,7 @@ impl KnnPlanarProjector {
     ) -> Result<Self, LossError> {
         check_cloud(points, normals)?;
         Ok(Self {
-            tree: build_tree(points),
+            tree: PointTree::new(points),
             points: points.to_vec(),
             normals: normals.iter().map(|n| n.normalize_or_zero()).collect(),
             options: *options,
@@ -142,37 +132,68 @@ impl KnnPlanarProjector {
         &self.normals
     }
 
+    /// Target point indices in a spatially coherent order (the kd-tree's leaf order).
+    pub(crate) fn spatial_order(&self) -> &[u32] {
+        self.tree.spatial_order()
+    }
+
     /// The `k` nearest target points of `p` as `(index, squared distance)`, sorted by distance
-    /// then index (distances recomputed in f64, so the order is exact). Fewer when the cloud is
-    /// smaller than `k`; empty for `k = 0` or a non-finite `p`.
+    /// then index (distances recomputed in f64, so the order is exact; the set is searched in
+    /// f32 and can differ from the exact one only at near-ties, within f32 precision). Fewer when
+    /// the cloud is smaller than `k`; empty for `k = 0` or a non-finite `p`.
     pub fn nearest(&self, p: DVec3, k: usize) -> Vec<(u32, f64)> {
-        let Some(k) = NonZero::new(k.min(self.points.len())) else {
-            return Vec::new();
-        };
-        if !p.is_finite() {
-            return Vec::new();
-        }
-        let mut found: Vec<(u32, f64)> = self
-            .tree
-            .nearest_n::<SquaredEuclidean>(&p.to_array(), k)
-            .into_iter()
-            .map(|nn| (nn.item, self.points[nn.item as usize].distance_squared(p)))
-            .collect();
-        found.sort_by(|a, b| a.1.total_cmp(&b.1).then(a.0.cmp(&b.0)));
+        let mut scratch = Neighbours::default();
+        let mut found = Vec::new();
+        self.nearest_into(p, k, &mut scratch, &mut found);
         found
+    }
+
+    /// [`KnnPlanarProjector::nearest`] into reusable buffers (no allocation once warm).
+    fn nearest_into(
+        &self,
+        p: DVec3,
+        k: usize,
+        scratch: &mut Neighbours,
+        found: &mut Vec<(u32, f64)>,
+    ) {
+        found.clear();
+        if !p.is_finite() {
+            return;
+        }
+        self.tree.nearest_n(p, k, scratch);
+        found.extend(
+            scratch
+                .items()
+                .iter()
+                .map(|&(_, j)| (j, self.points[j as usize].distance_squared(p))),
+        );
+        found.sort_unstable_by(|a, b| a.1.total_cmp(&b.1).then(a.0.cmp(&b.0)));
     }
 
     /// The move `d` of sample `s` with unit normal `n` (spec §3.2.2 s2t steps 1–3): `None` when
     /// no neighbour is valid or the input is not finite.
     pub fn displacement(&self, s: DVec3, n: DVec3) -> Option<DVec3> {
+        let mut scratch = Neighbours::default();
+        let mut found = Vec::new();
+        self.displacement_into(s, n, &mut scratch, &mut found)
+    }
+
+    /// [`KnnPlanarProjector::displacement`] with reusable buffers.
+    fn displacement_into(
+        &self,
+        s: DVec3,
+        n: DVec3,
+        scratch: &mut Neighbours,
+        found: &mut Vec<(u32, f64)>,
+    ) -> Option<DVec3> {
         if !s.is_finite() || !n.is_finite() {
             return None;
         }
-        let neighbours = self.nearest(s, self.options.k);
+        self.nearest_into(s, self.options.k, scratch, found);
         planar_move(
             s,
             n,
-            neighbours
+            found
                 .iter()
                 .map(|&(j, d2)| (self.points[j as usize], self.normals[j as usize], d2)),
             &self.options,
@@ -183,13 +204,15 @@ impl KnnPlanarProjector {
     /// (deterministic). A missing normal (`normals` shorter than `points`) gives `None`.
     pub fn displacements(&self, points: &[DVec3], normals: &[DVec3]) -> Vec<Option<DVec3>> {
         let work = |start: usize, chunk: &[DVec3]| -> Vec<Option<DVec3>> {
+            let mut scratch = Neighbours::default();
+            let mut found = Vec::with_capacity(self.options.k);
             chunk
                 .iter()
                 .enumerate()
                 .map(|(i, &s)| {
                     normals
                         .get(start + i)
-                        .and_then(|&n| self.displacement(s, n))
+                        .and_then(|&n| self.displacement_into(s, n, &mut scratch, &mut found))
                 })
                 .collect()
         };
@@ -239,9 +262,12 @@ pub fn planar_move(
         if cos.is_nan() || cos <= options.normal_dot_threshold {
             continue;
         }
-        let alpha = (t - s).dot(m) / cos;
+        let to_t = t - s;
+        let alpha = to_t.dot(m) / cos;
         let along = alpha * n;
-        let guard = (t - (s + along)).length() < options.blowup_guard * (t - s).length();
+        // |t − (s + along)| < guard·|t − s|, squared (both sides are non-negative).
+        let guard2 = options.blowup_guard * options.blowup_guard;
+        let guard = (to_t - along).length_squared() < guard2 * to_t.length_squared();
         if !guard || !along.is_finite() {
             continue;
         }
@@ -252,7 +278,7 @@ pub fn planar_move(
                 weight_sum += w;
             }
             PlanarMode::Orthogonal => {
-                weighted += w * (t - s).dot(m) * m;
+                weighted += w * to_t.dot(m) * m;
                 weight_sum += w;
             }
             PlanarMode::Nearest => {

@@ -7,6 +7,7 @@
 
 pub mod knn_projector;
 pub mod planar;
+mod point_tree;
 
 pub use knn_projector::{KnnOptions, KnnPlanarProjector, PlanarMode};
 pub use planar::{PlanarLoss, PlanarOptions, PlanarStats};

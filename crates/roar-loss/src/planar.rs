@@ -8,13 +8,16 @@
 //! face's three vertices through its barycentric weights.
 
 use glam::DVec3;
-use kiddo::SquaredEuclidean;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
-use roar_mesh::spatial::{RegularSamples, RegularSamplingOptions, regular_samples};
+use roar_mesh::spatial::regular_sampling::{
+    continuous_grid_size, face_grid, grid_point_count, round_grid_size,
+};
+use roar_mesh::spatial::{RegularSamples, RegularSamplingOptions};
 
-use crate::knn_projector::{KnnOptions, KnnPlanarProjector, build_tree};
+use crate::knn_projector::{KnnOptions, KnnPlanarProjector};
+use crate::point_tree::PointTree;
 use crate::{Loss, LossError};
 
 /// Target points per parallel work item of the t2s assignment.
@@ -30,6 +33,16 @@ const CHUNK: usize = 4096;
 /// closes (it is quadratic), the render term does not.
 pub const DEFAULT_PLANAR_SCALE: f64 = 5.0;
 
+/// Default of [`PlanarOptions::max_samples`]: 50 000 source samples per evaluation, the sample
+/// count of [SUP Fig. 1] (spec §3.2.2, §7.2). Measured by `examples/planar_profile.rs`
+/// (`CAP_STUDY=1`; 5 120-face bumpy sphere, 263k regular samples uncapped, P = 50k): the relative
+/// L2 error of one evaluation's gradient against uncapped evaluations is 5.2% uncapped (the
+/// floor set by the stochastic grid rounding), 6.1% at 100k, 8.7% at 50k, 13.5% at 25k; the loss
+/// value moves by 3e-4 relative at 50k. The evaluation costs about half of the 100k cap (the
+/// k-NN queries and the t2s tree scale with the sample count), which keeps it under 100 ms on
+/// two cores at 5k faces; the per-iteration noise averages out over the optimizer's steps.
+pub const DEFAULT_MAX_SAMPLES: usize = 50_000;
+
 /// Options of [`PlanarLoss`] (spec §3.2.2, §3.3, OQ-3).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct PlanarOptions {
@@ -41,8 +54,8 @@ pub struct PlanarOptions {
     pub t2s_normal_dot: f64,
     /// Regular sampling of the source (spec §3.3: δ = 0.002, n ≤ 16, n ≥ 3).
     pub sampling: RegularSamplingOptions,
-    /// Cap on source samples per evaluation (default 100 000). Above it, every face keeps a
-    /// share `cap/total` of its samples (stratified, see [`stratified_subsample`]).
+    /// Cap on source samples per evaluation (default [`DEFAULT_MAX_SAMPLES`]). Above it, every
+    /// face keeps a share `cap/total` of its samples (stratified, see [`stratified_subsample`]).
     pub max_samples: usize,
     /// Multiplies the raw loss `mean_i ‖d_i‖²` and its gradient (Verification note 2).
     /// 1 is the raw spec loss; the default [`DEFAULT_PLANAR_SCALE`] makes the planar gradient
@@ -60,7 +73,7 @@ impl Default for PlanarOptions {
             t2s: true,
             t2s_normal_dot: 0.95,
             sampling: RegularSamplingOptions::default(),
-            max_samples: 100_000,
+            max_samples: DEFAULT_MAX_SAMPLES,
             scale: DEFAULT_PLANAR_SCALE,
             seed: 0,
         }
@@ -136,35 +149,29 @@ impl PlanarLoss {
         if !self.options.t2s {
             return s2t;
         }
-        let t2s = t2s_moves(
+        let t2s = t2s_moves_in_order(
             points,
             normals,
             self.projector.points(),
             self.projector.normals(),
             self.options.t2s_normal_dot,
+            self.projector.spatial_order(),
         );
         combine_moves(&s2t, &t2s)
     }
 
-    /// The regular samples of this evaluation: samples every face with vertex normals of the
-    /// source (spec §2.2), advances the RNG, then applies the cap. Returns the samples and the
-    /// indices kept.
-    fn draw_samples(
-        &mut self,
-        positions: &[DVec3],
-        triangles: &[[u32; 3]],
-    ) -> Result<(RegularSamples, Vec<usize>), LossError> {
+    /// The regular samples of this evaluation under the cap (spec §3.3, normals blended from
+    /// the source's ROAR vertex normals, spec §2.2); advances the RNG.
+    fn draw_samples(&mut self, positions: &[DVec3], triangles: &[[u32; 3]]) -> CappedSamples {
         let normals = vertex_normals(positions, triangles);
-        let samples = regular_samples(
+        capped_regular_samples(
             positions,
             triangles,
-            Some(&normals),
+            &normals,
             &self.options.sampling,
+            self.options.max_samples,
             &mut self.rng,
         )
-        .map_err(|e| LossError::InvalidMesh(e.to_string()))?;
-        let kept = stratified_subsample(&samples, self.options.max_samples, &mut self.rng);
-        Ok((samples, kept))
     }
 }
 
@@ -179,20 +186,23 @@ impl Loss for PlanarLoss {
         triangles: &[[u32; 3]],
     ) -> Result<(f64, Vec<DVec3>), LossError> {
         check_mesh(positions, triangles)?;
-        let (samples, kept) = self.draw_samples(positions, triangles)?;
-        let points: Vec<DVec3> = kept.iter().map(|&i| samples.points[i]).collect();
-        let normals: Vec<DVec3> = kept.iter().map(|&i| samples.normals[i]).collect();
-        let faces: Vec<u32> = kept.iter().map(|&i| samples.faces[i]).collect();
-        let barycentrics: Vec<[f64; 3]> = kept.iter().map(|&i| samples.barycentrics[i]).collect();
+        let CappedSamples {
+            points,
+            normals,
+            faces,
+            barycentrics,
+            generated,
+        } = self.draw_samples(positions, triangles);
 
         let s2t = self.projector.displacements(&points, &normals);
         let (moves, from_t2s) = if self.options.t2s {
-            let t2s = t2s_moves(
+            let t2s = t2s_moves_in_order(
                 &points,
                 &normals,
                 self.projector.points(),
                 self.projector.normals(),
                 self.options.t2s_normal_dot,
+                self.projector.spatial_order(),
             );
             let from_t2s = s2t
                 .iter()
@@ -214,7 +224,7 @@ impl Loss for PlanarLoss {
             *g *= self.options.scale;
         }
         self.last_stats = PlanarStats {
-            samples_generated: samples.points.len(),
+            samples_generated: generated,
             samples_used: points.len(),
             unprojected: moves.iter().filter(|d| d.is_none()).count(),
             from_t2s,
@@ -251,8 +261,8 @@ pub fn combine_moves(s2t: &[Option<DVec3>], t2s: &[Option<DVec3>]) -> Vec<Option
 }
 
 /// The target→source term (spec §3.2.2 t2s): every target point is assigned to its nearest
-/// sample (kd-tree over the samples, ties to the smaller sample index via the tree's fixed
-/// order); each sample takes its farthest assigned point `t*` (ties: smaller target index) and,
+/// sample (f32 kd-tree over the samples, ties to the smaller sample index; the assigned
+/// distance is recomputed in f64); each sample takes its farthest assigned point `t*` (ties: smaller target index) and,
 /// if `m_{t*}·n_i ≥ normal_dot`, the along-normal intersection with the plane `(t*, m_{t*})`.
 /// The blow-up guard of s2t is not applied (the 0.95 gate bounds the move). `None` for samples
 /// with no assigned point, a failed gate, or non-finite input.
@@ -263,6 +273,27 @@ pub fn t2s_moves(
     target_normals: &[DVec3],
     normal_dot: f64,
 ) -> Vec<Option<DVec3>> {
+    let order: Vec<u32> = (0..target_points.len() as u32).collect();
+    t2s_moves_in_order(
+        samples,
+        sample_normals,
+        target_points,
+        target_normals,
+        normal_dot,
+        &order,
+    )
+}
+
+/// [`t2s_moves`] visiting the target points in `order` (a permutation of their indices; a
+/// spatially coherent one makes the searches cheaper, the result does not depend on it).
+fn t2s_moves_in_order(
+    samples: &[DVec3],
+    sample_normals: &[DVec3],
+    target_points: &[DVec3],
+    target_normals: &[DVec3],
+    normal_dot: f64,
+    order: &[u32],
+) -> Vec<Option<DVec3>> {
     let mut result = vec![None; samples.len()];
     let finite: Vec<usize> = (0..samples.len())
         .filter(|&i| samples[i].is_finite())
@@ -271,24 +302,40 @@ pub fn t2s_moves(
         return result;
     }
     let finite_points: Vec<DVec3> = finite.iter().map(|&i| samples[i]).collect();
-    let tree = build_tree(&finite_points);
-    let assign = |t: &DVec3| -> Option<(u32, f64)> {
-        if !t.is_finite() {
-            return None;
-        }
-        let nn = tree.nearest_one::<SquaredEuclidean>(&t.to_array());
-        let i = finite[nn.item as usize];
-        Some((i as u32, samples[i].distance_squared(*t)))
+    let tree = PointTree::new(&finite_points);
+    // Each target point goes to its nearest sample; the previous answer of the chunk bounds the
+    // next search (it never changes the answer).
+    let assign_chunk = |chunk: &[u32]| -> Vec<Option<(u32, f64)>> {
+        let mut hint = None;
+        chunk
+            .iter()
+            .map(|&j| {
+                let t = *target_points.get(j as usize)?;
+                if !t.is_finite() {
+                    return None;
+                }
+                let local = tree.nearest_one(t, hint)?;
+                hint = Some(local);
+                let i = finite[local as usize];
+                Some((i as u32, samples[i].distance_squared(t)))
+            })
+            .collect()
     };
-    let assigned: Vec<Option<(u32, f64)>> = if target_points.len() <= CHUNK {
-        target_points.iter().map(assign).collect()
+    let assigned_in_order: Vec<Option<(u32, f64)>> = if order.len() <= CHUNK {
+        assign_chunk(order)
     } else {
-        target_points
+        order
             .par_chunks(CHUNK)
-            .map(|chunk| chunk.iter().map(assign).collect::<Vec<_>>())
+            .map(assign_chunk)
             .collect::<Vec<_>>()
             .concat()
     };
+    let mut assigned: Vec<Option<(u32, f64)>> = vec![None; target_points.len()];
+    for (&j, a) in order.iter().zip(assigned_in_order) {
+        if let Some(slot) = assigned.get_mut(j as usize) {
+            *slot = a;
+        }
+    }
     let mut farthest: Vec<Option<(usize, f64)>> = vec![None; samples.len()];
     for (j, a) in assigned.iter().enumerate() {
         let Some((i, d2)) = *a else { continue };
@@ -372,15 +419,36 @@ pub fn stratified_subsample(
     cap: usize,
     rng: &mut impl Rng,
 ) -> Vec<usize> {
-    let total = samples.points.len();
+    let counts: Vec<usize> = (0..samples.face_n.len())
+        .map(|f| samples.face_samples(f).len())
+        .collect();
+    let mut kept = Vec::with_capacity(cap.min(samples.points.len()) + counts.len());
+    stratified_pick(&counts, cap, rng, |f, local| {
+        kept.push(samples.face_samples(f).start + local)
+    });
+    kept
+}
+
+/// The selection of [`stratified_subsample`] from per-face sample counts alone: calls
+/// `keep(face, local index)` for every kept sample, in face order then ascending local index.
+/// Draws from `rng` exactly as [`stratified_subsample`] does (nothing when all are kept).
+fn stratified_pick(
+    counts: &[usize],
+    cap: usize,
+    rng: &mut impl Rng,
+    mut keep: impl FnMut(usize, usize),
+) {
+    let total: usize = counts.iter().sum();
     if total <= cap {
-        return (0..total).collect();
+        for (f, &m) in counts.iter().enumerate() {
+            for local in 0..m {
+                keep(f, local);
+            }
+        }
+        return;
     }
     let p = cap as f64 / total as f64;
-    let mut kept = Vec::with_capacity(cap + samples.face_n.len());
-    for f in 0..samples.face_n.len() {
-        let range = samples.face_samples(f);
-        let m = range.len();
+    for (f, &m) in counts.iter().enumerate() {
         let u: f64 = rng.random();
         let k = ((p * m as f64 + u).floor() as usize).min(m);
         if k == 0 {
@@ -389,11 +457,105 @@ pub fn stratified_subsample(
         let stride = m as f64 / k as f64;
         let offset: f64 = rng.random::<f64>() * stride;
         for j in 0..k {
-            let local = ((offset + j as f64 * stride) as usize).min(m - 1);
-            kept.push(range.start + local);
+            keep(f, ((offset + j as f64 * stride) as usize).min(m - 1));
         }
     }
-    kept
+}
+
+/// The kept regular samples of one evaluation, as parallel arrays.
+struct CappedSamples {
+    points: Vec<DVec3>,
+    normals: Vec<DVec3>,
+    faces: Vec<u32>,
+    barycentrics: Vec<[f64; 3]>,
+    /// Regular samples the grids hold before the cap.
+    generated: usize,
+}
+
+/// [`regular_samples`](roar_mesh::spatial::regular_samples) followed by
+/// [`stratified_subsample`], without generating the samples the
+/// cap drops: grid sizes first (same RNG draws as `regular_samples`), then the stratified pick
+/// from the per-face counts (same draws as `stratified_subsample`), then only the kept points.
+/// Gives the same samples, bit for bit, as the two-step route. The mesh must be checked
+/// (indices in range) and `vertex_normals` must hold one normal per position.
+fn capped_regular_samples(
+    positions: &[DVec3],
+    triangles: &[[u32; 3]],
+    vertex_normals: &[DVec3],
+    sampling: &RegularSamplingOptions,
+    cap: usize,
+    rng: &mut impl Rng,
+) -> CappedSamples {
+    let diagonal = referenced_bbox_diagonal(positions, triangles);
+    let sizes: Vec<u32> = triangles
+        .iter()
+        .map(|tri| {
+            let [p0, p1, p2] = tri.map(|v| positions[v as usize]);
+            let doubled_area = (p1 - p0).cross(p2 - p0).length();
+            let n_cont = continuous_grid_size(doubled_area, diagonal, sampling.density);
+            round_grid_size(n_cont, sampling.min_n, sampling.max_n, rng)
+        })
+        .collect();
+    let counts: Vec<usize> = sizes.iter().map(|&n| grid_point_count(n)).collect();
+    let generated = counts.iter().sum();
+    let mut picks: Vec<(u32, u32)> = Vec::with_capacity(cap.min(generated) + triangles.len());
+    stratified_pick(&counts, cap, rng, |f, local| {
+        picks.push((f as u32, local as u32))
+    });
+
+    // Barycentric grids per size (at most `max_n` distinct ones).
+    let largest = sizes.iter().copied().max().unwrap_or(0) as usize;
+    let mut grids: Vec<Vec<[f64; 3]>> = vec![Vec::new(); largest + 1];
+    for &n in &sizes {
+        if grids[n as usize].is_empty() {
+            grids[n as usize] = face_grid(n).0;
+        }
+    }
+    let mut out = CappedSamples {
+        points: Vec::with_capacity(picks.len()),
+        normals: Vec::with_capacity(picks.len()),
+        faces: Vec::with_capacity(picks.len()),
+        barycentrics: Vec::with_capacity(picks.len()),
+        generated,
+    };
+    for &(f, local) in &picks {
+        let tri = triangles[f as usize];
+        let corners = tri.map(|v| positions[v as usize]);
+        let w = grids[sizes[f as usize] as usize][local as usize];
+        let vn = tri.map(|v| vertex_normals[v as usize]);
+        let blended = (w[0] * vn[0] + w[1] * vn[1] + w[2] * vn[2]).normalize_or_zero();
+        let normal = if blended == DVec3::ZERO {
+            (corners[1] - corners[0])
+                .cross(corners[2] - corners[0])
+                .normalize_or_zero()
+        } else {
+            blended
+        };
+        out.points
+            .push(w[0] * corners[0] + w[1] * corners[1] + w[2] * corners[2]);
+        out.normals.push(normal);
+        out.faces.push(f);
+        out.barycentrics.push(w);
+    }
+    out
+}
+
+/// Bounding-box diagonal of the vertices referenced by `triangles` (0 when there are none), the
+/// D of the sampling density (spec §3.3).
+fn referenced_bbox_diagonal(positions: &[DVec3], triangles: &[[u32; 3]]) -> f64 {
+    let mut lo = DVec3::splat(f64::INFINITY);
+    let mut hi = DVec3::splat(f64::NEG_INFINITY);
+    for tri in triangles {
+        for &v in tri {
+            lo = lo.min(positions[v as usize]);
+            hi = hi.max(positions[v as usize]);
+        }
+    }
+    if triangles.is_empty() {
+        0.0
+    } else {
+        (hi - lo).length()
+    }
 }
 
 /// ROAR vertex normals (spec §2.2): `N_v = Σ_{f∋v} A_f θ_{f,v} n_f`, normalized (area **times**
@@ -456,6 +618,44 @@ mod tests {
         let t = [[0, 1, 2], [0, 3, 1], [0, 2, 3], [1, 3, 2]];
         for (v, n) in vertex_normals(&p, &t).iter().enumerate() {
             assert!((n.dot(p[v].normalize()) - 1.0).abs() < 1e-12);
+        }
+    }
+
+    #[test]
+    fn capped_sampler_matches_sampling_then_subsampling() {
+        use rand::SeedableRng;
+        use roar_mesh::shapes::{icosphere, perturbed};
+        use roar_mesh::spatial::regular_samples;
+        let (p, t) = perturbed(&icosphere(2), 0.05, 9).to_triangles();
+        let normals = vertex_normals(&p, &t);
+        let options = RegularSamplingOptions {
+            density: 0.01,
+            ..RegularSamplingOptions::default()
+        };
+        for cap in [usize::MAX, 5000, 700, 0] {
+            let mut a = ChaCha8Rng::seed_from_u64(5);
+            let mut b = a.clone();
+            let full = regular_samples(&p, &t, Some(&normals), &options, &mut a).unwrap();
+            let kept = stratified_subsample(&full, cap, &mut a);
+            let capped = capped_regular_samples(&p, &t, &normals, &options, cap, &mut b);
+            assert!(kept.len() < full.points.len() || cap == usize::MAX);
+            assert_eq!(capped.generated, full.points.len());
+            assert_eq!(
+                capped.points,
+                kept.iter().map(|&i| full.points[i]).collect::<Vec<_>>()
+            );
+            assert_eq!(
+                capped.normals,
+                kept.iter().map(|&i| full.normals[i]).collect::<Vec<_>>()
+            );
+            assert_eq!(
+                capped.faces,
+                kept.iter().map(|&i| full.faces[i]).collect::<Vec<_>>()
+            );
+            let bary: Vec<[f64; 3]> = kept.iter().map(|&i| full.barycentrics[i]).collect();
+            assert_eq!(capped.barycentrics, bary);
+            // Both routes leave the generator in the same state.
+            assert_eq!(a.random::<u64>(), b.random::<u64>());
         }
     }
 

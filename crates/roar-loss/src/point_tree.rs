@@ -1,0 +1,415 @@
+//! A static kd-tree over 3-D points for k-nearest and nearest-one queries, with f32 coordinates
+//! and allocation-free queries (the hot loop of the planar loss, spec §3.2.2).
+//!
+//! Geometry is normalized into a sphere of radius about 1, where f32 (relative precision 6e-8)
+//! finds the same neighbours as f64 except for near-ties; callers that need exact distances
+//! recompute them in f64 from their own points. Results are ordered by (f32 squared distance,
+//! index), a total order that does not depend on the traversal, so a query's answer is a pure
+//! function of the tree's input and the query point.
+
+use glam::DVec3;
+
+/// Points per leaf: small enough to prune well, large enough to amortize the descent.
+const LEAF_SIZE: usize = 16;
+
+/// Subtrees with at least this many points build their two halves in parallel.
+const PARALLEL_BUILD: usize = 16_384;
+
+/// `Node::axis` value of a leaf.
+const LEAF: u8 = 3;
+
+/// Relative slack on the pruning bound, so f32 rounding of the incremental cell distance never
+/// skips a cell that holds a point tying with the current worst neighbour.
+const PRUNE_SLACK: f32 = 1.0 + 1e-5;
+
+/// One node, in preorder (the left child of an inner node is the next node).
+#[derive(Debug, Clone, Copy)]
+struct Node {
+    /// First point of the node in tree order.
+    start: u32,
+    /// One past the last point.
+    end: u32,
+    /// Split axis (0, 1, 2), or [`LEAF`].
+    axis: u8,
+    /// Left points have `coord[axis] ≤ split`, right points `≥ split`.
+    split: f32,
+    /// Index of the right child (inner nodes only).
+    right: u32,
+}
+
+/// A kd-tree over a fixed set of points (median split on the widest axis, leaves of at most
+/// [`LEAF_SIZE`] points). The point indices it returns are positions in the input slice.
+#[derive(Debug, Clone, Default)]
+pub(crate) struct PointTree {
+    nodes: Vec<Node>,
+    /// Point coordinates in tree order, one array per axis (each leaf's points are contiguous,
+    /// so a leaf's distances compute in SIMD lanes).
+    xs: Vec<f32>,
+    ys: Vec<f32>,
+    zs: Vec<f32>,
+    /// Input index of each point in tree order.
+    ids: Vec<u32>,
+    /// Point coordinates in input order (to turn a previous answer into a search bound).
+    coords_by_id: Vec<[f32; 3]>,
+}
+
+/// The best neighbours of one query, sorted by (squared distance, index); a reusable buffer so
+/// queries do not allocate. The previous answer also seeds the next query's search bound
+/// (consecutive queries are usually close), which changes the work, never the answer.
+#[derive(Debug, Clone, Default)]
+pub(crate) struct Neighbours {
+    items: Vec<(f32, u32)>,
+    k: usize,
+    /// Squared distance within which at least `k` points are known to lie (∞ if unknown).
+    limit: f32,
+}
+
+impl Neighbours {
+    /// The neighbours found by the last query: `(f32 squared distance, index)` pairs, nearest
+    /// first.
+    pub(crate) fn items(&self) -> &[(f32, u32)] {
+        &self.items
+    }
+
+    /// Clears the buffer for a query of `k` neighbours known to lie within squared distance
+    /// `limit`.
+    fn reset(&mut self, k: usize, limit: f32) {
+        self.items.clear();
+        self.k = k;
+        self.limit = limit;
+    }
+
+    /// The squared distance a point must not exceed to enter: the limit until `k` are found,
+    /// then the current `k`-th distance (never above the limit).
+    #[inline]
+    fn bound(&self) -> f32 {
+        if self.items.len() < self.k {
+            self.limit
+        } else {
+            self.items[self.k - 1].0
+        }
+    }
+
+    /// Inserts `(d2, id)` if it is among the `k` best so far (ties broken by smaller index).
+    #[inline]
+    fn offer(&mut self, d2: f32, id: u32) {
+        let before = |item: &(f32, u32)| item.0 < d2 || (item.0 == d2 && item.1 < id);
+        let len = self.items.len();
+        if len == self.k {
+            if before(&self.items[len - 1]) {
+                return;
+            }
+        } else {
+            self.items.push((d2, id));
+        }
+        // Shift the worse items up by one (dropping the last when full) and insert.
+        let items = &mut self.items[..];
+        let mut pos = items.len() - 1;
+        while pos > 0 && !before(&items[pos - 1]) {
+            items[pos] = items[pos - 1];
+            pos -= 1;
+        }
+        items[pos] = (d2, id);
+    }
+}
+
+/// Appends to `nodes` the subtree over `entries` (tree positions from `start`), in preorder
+/// with absolute child indices. Large halves are built in parallel into their own vectors and
+/// spliced in, which gives the same nodes as the serial recursion.
+fn build(entries: &mut [([f32; 3], u32)], start: usize, nodes: &mut Vec<Node>) {
+    let index = nodes.len();
+    let count = entries.len();
+    let mut node = Node {
+        start: start as u32,
+        end: (start + count) as u32,
+        axis: LEAF,
+        split: 0.0,
+        right: 0,
+    };
+    if count <= LEAF_SIZE {
+        nodes.push(node);
+        return;
+    }
+    let mut lo = [f32::INFINITY; 3];
+    let mut hi = [f32::NEG_INFINITY; 3];
+    for (c, _) in entries.iter() {
+        for a in 0..3 {
+            lo[a] = lo[a].min(c[a]);
+            hi[a] = hi[a].max(c[a]);
+        }
+    }
+    let extent = [hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]];
+    let axis = if extent[0] >= extent[1] && extent[0] >= extent[2] {
+        0
+    } else if extent[1] >= extent[2] {
+        1
+    } else {
+        2
+    };
+    let mid = count / 2;
+    entries.select_nth_unstable_by(mid, |a, b| {
+        a.0[axis].total_cmp(&b.0[axis]).then(a.1.cmp(&b.1))
+    });
+    node.axis = axis as u8;
+    node.split = entries[mid].0[axis];
+    nodes.push(node);
+    let (left, right) = entries.split_at_mut(mid);
+    if count < PARALLEL_BUILD {
+        build(left, start, nodes);
+        nodes[index].right = nodes.len() as u32;
+        build(right, start + mid, nodes);
+        return;
+    }
+    let subtree = |entries: &mut [([f32; 3], u32)], start: usize| {
+        let mut sub = Vec::with_capacity(2 * entries.len() / LEAF_SIZE + 1);
+        build(entries, start, &mut sub);
+        sub
+    };
+    let (left_nodes, right_nodes) =
+        rayon::join(|| subtree(left, start), || subtree(right, start + mid));
+    let right_index = index + 1 + left_nodes.len();
+    nodes[index].right = right_index as u32;
+    for (offset, sub) in [(index + 1, left_nodes), (right_index, right_nodes)] {
+        nodes.extend(sub.into_iter().map(|mut n| {
+            if n.axis != LEAF {
+                n.right += offset as u32;
+            }
+            n
+        }));
+    }
+}
+
+#[inline]
+fn to_f32(p: DVec3) -> [f32; 3] {
+    [p.x as f32, p.y as f32, p.z as f32]
+}
+
+#[inline]
+fn distance2(a: &[f32; 3], b: &[f32; 3]) -> f32 {
+    let (dx, dy, dz) = (a[0] - b[0], a[1] - b[1], a[2] - b[2]);
+    dx * dx + dy * dy + dz * dz
+}
+
+impl PointTree {
+    /// Builds the tree over `points` (finite, fewer than 2³² — the callers check both).
+    /// Deterministic: the same input gives the same tree.
+    pub(crate) fn new(points: &[DVec3]) -> Self {
+        let mut entries: Vec<([f32; 3], u32)> = points
+            .iter()
+            .enumerate()
+            .map(|(i, &p)| (to_f32(p), i as u32))
+            .collect();
+        let mut tree = Self {
+            nodes: Vec::with_capacity(2 * points.len() / LEAF_SIZE + 1),
+            ..Self::default()
+        };
+        if !entries.is_empty() {
+            build(&mut entries, 0, &mut tree.nodes);
+        }
+        tree.xs = entries.iter().map(|e| e.0[0]).collect();
+        tree.ys = entries.iter().map(|e| e.0[1]).collect();
+        tree.zs = entries.iter().map(|e| e.0[2]).collect();
+        tree.coords_by_id = points.iter().map(|&p| to_f32(p)).collect();
+        tree.ids = entries.iter().map(|e| e.1).collect();
+        tree
+    }
+
+    /// Input indices in tree order: a spatially coherent visiting order (points of a leaf are
+    /// adjacent), which makes the hints of consecutive queries tight.
+    pub(crate) fn spatial_order(&self) -> &[u32] {
+        &self.ids
+    }
+
+    /// Fills `found` with the `k` nearest points of `query` (fewer if the tree is smaller),
+    /// sorted by (f32 squared distance, index). `k = 0` or an empty tree gives nothing.
+    /// `found`'s previous answer (any `k` distinct points of this tree) bounds the search.
+    pub(crate) fn nearest_n(&self, query: DVec3, k: usize, found: &mut Neighbours) {
+        let q = to_f32(query);
+        let mut limit = f32::INFINITY;
+        if k > 0 && found.items.len() == k {
+            // The previous k neighbours all lie within `limit` of the new query.
+            limit = 0.0;
+            for &(_, id) in &found.items {
+                match self.coords_by_id.get(id as usize) {
+                    Some(c) => limit = limit.max(distance2(c, &q)),
+                    None => limit = f32::INFINITY,
+                }
+            }
+        }
+        found.reset(k, limit);
+        if k == 0 || self.nodes.is_empty() {
+            return;
+        }
+        self.search(0, &q, [0.0; 3], 0.0, found);
+    }
+
+    /// The nearest point of `query` (ties: smaller index); `None` for an empty tree. `hint`, a
+    /// point of this tree (e.g. the previous answer), bounds the search.
+    pub(crate) fn nearest_one(&self, query: DVec3, hint: Option<u32>) -> Option<u32> {
+        if self.nodes.is_empty() {
+            return None;
+        }
+        let q = to_f32(query);
+        let limit = hint
+            .and_then(|id| self.coords_by_id.get(id as usize))
+            .map_or(f32::INFINITY, |c| distance2(c, &q));
+        // Starts at (limit, u32::MAX): the hint itself always qualifies, so `best` is filled.
+        let mut best = (limit, u32::MAX);
+        self.search_one(0, &q, [0.0; 3], 0.0, &mut best);
+        Some(best.1)
+    }
+
+    /// [`PointTree::search`] for a single neighbour `best = (d2, id)`, without the buffer.
+    fn search_one(&self, node: u32, q: &[f32; 3], off: [f32; 3], rd: f32, best: &mut (f32, u32)) {
+        let nd = self.nodes[node as usize];
+        if nd.axis == LEAF {
+            let (start, end) = (nd.start as usize, nd.end as usize);
+            let mut d2 = [0.0; LEAF_SIZE];
+            let d2 = self.leaf_distances(nd, q, &mut d2);
+            for (&d2, &id) in d2.iter().zip(&self.ids[start..end]) {
+                if d2 < best.0 || (d2 == best.0 && id < best.1) {
+                    *best = (d2, id);
+                }
+            }
+            return;
+        }
+        let axis = nd.axis as usize;
+        let diff = q[axis] - nd.split;
+        let (near, far) = if diff < 0.0 {
+            (node + 1, nd.right)
+        } else {
+            (nd.right, node + 1)
+        };
+        self.search_one(near, q, off, rd, best);
+        let far_rd = rd - off[axis] * off[axis] + diff * diff;
+        if far_rd <= best.0 * PRUNE_SLACK {
+            let mut far_off = off;
+            far_off[axis] = diff;
+            self.search_one(far, q, far_off, far_rd, best);
+        }
+    }
+
+    /// Squared distances from `q` to the points of leaf `leaf`, written to the front of `out`.
+    #[inline]
+    fn leaf_distances<'a>(
+        &self,
+        leaf: Node,
+        q: &[f32; 3],
+        out: &'a mut [f32; LEAF_SIZE],
+    ) -> &'a [f32] {
+        let (start, end) = (leaf.start as usize, leaf.end as usize);
+        let out = &mut out[..end - start];
+        let (xs, ys, zs) = (
+            &self.xs[start..end],
+            &self.ys[start..end],
+            &self.zs[start..end],
+        );
+        for i in 0..out.len() {
+            let (dx, dy, dz) = (xs[i] - q[0], ys[i] - q[1], zs[i] - q[2]);
+            out[i] = dx * dx + dy * dy + dz * dz;
+        }
+        out
+    }
+
+    /// Visits `node` whose cell lies at squared distance `rd` (per-axis offsets `off`).
+    fn search(&self, node: u32, q: &[f32; 3], off: [f32; 3], rd: f32, found: &mut Neighbours) {
+        let nd = self.nodes[node as usize];
+        if nd.axis == LEAF {
+            let (start, end) = (nd.start as usize, nd.end as usize);
+            let mut d2 = [0.0; LEAF_SIZE];
+            let d2 = self.leaf_distances(nd, q, &mut d2);
+            for (&d2, &id) in d2.iter().zip(&self.ids[start..end]) {
+                if d2 <= found.bound() {
+                    found.offer(d2, id);
+                }
+            }
+            return;
+        }
+        let axis = nd.axis as usize;
+        let diff = q[axis] - nd.split;
+        let (near, far) = if diff < 0.0 {
+            (node + 1, nd.right)
+        } else {
+            (nd.right, node + 1)
+        };
+        self.search(near, q, off, rd, found);
+        let far_rd = rd - off[axis] * off[axis] + diff * diff;
+        if far_rd <= found.bound() * PRUNE_SLACK {
+            let mut far_off = off;
+            far_off[axis] = diff;
+            self.search(far, q, far_off, far_rd, found);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rand::{Rng, SeedableRng};
+    use rand_chacha::ChaCha8Rng;
+
+    fn brute(points: &[DVec3], q: DVec3, k: usize) -> Vec<(f32, u32)> {
+        let qf = to_f32(q);
+        let mut all: Vec<(f32, u32)> = points
+            .iter()
+            .enumerate()
+            .map(|(i, &p)| (distance2(&to_f32(p), &qf), i as u32))
+            .collect();
+        all.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+        all.truncate(k);
+        all
+    }
+
+    #[test]
+    fn matches_brute_force_in_f32_including_duplicates() {
+        let mut rng = ChaCha8Rng::seed_from_u64(3);
+        // 40 000 points exercise the parallel build.
+        for n in [1usize, 5, 13, 100, 2000, 40_000] {
+            let mut points: Vec<DVec3> = (0..n)
+                .map(|_| DVec3::new(rng.random(), rng.random(), rng.random()) * 2.0 - DVec3::ONE)
+                .collect();
+            // Exact duplicates and a flat patch stress the tie order and degenerate cells.
+            for i in 0..n / 4 {
+                points[i] = points[n - 1 - i];
+            }
+            for p in points.iter_mut().take(n / 3) {
+                p.z = 0.25;
+            }
+            let tree = PointTree::new(&points);
+            // One buffer across queries and k: the previous answer seeds each search bound.
+            let mut found = Neighbours::default();
+            let mut previous = None;
+            for _ in 0..50 {
+                let q = DVec3::new(rng.random(), rng.random(), rng.random()) * 2.4 - DVec3::ONE;
+                for k in [1, 10, 40] {
+                    tree.nearest_n(q, k, &mut found);
+                    assert_eq!(
+                        found.items(),
+                        brute(&points, q, k).as_slice(),
+                        "n {n} k {k}"
+                    );
+                }
+                for hint in [None, previous, Some(0)] {
+                    assert_eq!(
+                        tree.nearest_one(q, hint),
+                        Some(brute(&points, q, 1)[0].1),
+                        "nearest one, n {n}"
+                    );
+                }
+                previous = tree.nearest_one(q, None);
+            }
+        }
+    }
+
+    #[test]
+    fn empty_tree_and_zero_k_give_nothing() {
+        let tree = PointTree::new(&[]);
+        assert_eq!(tree.nearest_one(DVec3::ZERO, Some(3)), None);
+        let tree = PointTree::new(&[DVec3::X]);
+        let mut found = Neighbours::default();
+        tree.nearest_n(DVec3::ZERO, 0, &mut found);
+        assert!(found.items().is_empty());
+        tree.nearest_n(DVec3::ZERO, 3, &mut found);
+        assert_eq!(found.items(), &[(1.0, 0)]);
+    }
+}
