@@ -33,15 +33,14 @@ const CHUNK: usize = 4096;
 /// closes (it is quadratic), the render term does not.
 pub const DEFAULT_PLANAR_SCALE: f64 = 5.0;
 
-/// Default of [`PlanarOptions::max_samples`]: 50 000 source samples per evaluation, the sample
-/// count of [SUP Fig. 1] (spec §3.2.2, §7.2). Measured by `examples/planar_profile.rs`
-/// (`CAP_STUDY=1`; 5 120-face bumpy sphere, 263k regular samples uncapped, P = 50k): the relative
-/// L2 error of one evaluation's gradient against uncapped evaluations is 5.2% uncapped (the
-/// floor set by the stochastic grid rounding), 6.1% at 100k, 8.7% at 50k, 13.5% at 25k; the loss
-/// value moves by 3e-4 relative at 50k. The evaluation costs about half of the 100k cap (the
-/// k-NN queries and the t2s tree scale with the sample count), which keeps it under 100 ms on
-/// two cores at 5k faces; the per-iteration noise averages out over the optimizer's steps.
-pub const DEFAULT_MAX_SAMPLES: usize = 50_000;
+/// Default of [`PlanarOptions::max_samples`]: 100 000 source samples per evaluation (spec
+/// §3.2.2: the spec's density gives 150–300k on a typical shape). Measured by
+/// `examples/planar_profile.rs` (`CAP_STUDY=1`; 5 120-face bumpy sphere, 263k regular samples
+/// uncapped, P = 50k): the relative L2 error of one evaluation's gradient against uncapped
+/// evaluations is 5.2% uncapped (the floor set by the stochastic grid rounding), 6.1% at 100k,
+/// 8.7% at 50k, 13.5% at 25k. A 50k cap halves the cost (the k-NN queries and the t2s tree scale
+/// with the sample count) at a small loss of gradient accuracy.
+pub const DEFAULT_MAX_SAMPLES: usize = 100_000;
 
 /// Options of [`PlanarLoss`] (spec §3.2.2, §3.3, OQ-3).
 #[derive(Debug, Clone, Copy, PartialEq)]
