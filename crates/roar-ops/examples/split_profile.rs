@@ -87,8 +87,9 @@ fn main() {
             let mut m = mesh.clone();
             let mut o = Optimizer::new(m.vertex_capacity(), OptimizerOptions::default())
                 .expect("optimizer");
+            let t = Instant::now();
             let stats = face_split(&mut m, &mut o, &sphere, f + 2000, &options);
-            println!("accepted {}", stats.accepted);
+            println!("face_split {:.1} ms, accepted {}", ms(t), stats.accepted);
             continue;
         }
         // Phase breakdown (the block recomputes these itself).
