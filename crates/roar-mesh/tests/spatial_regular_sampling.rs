@@ -320,3 +320,67 @@ fn samples_of_an_inscribed_face_project_onto_the_reference_sphere() {
         assert!((q - s.points[i]).cross(s.normals[i]).length() < 1e-12);
     }
 }
+
+/// Per-face grids written one after another from [`face_grid`], the direct reading of the layout
+/// (face normals only).
+fn sequential_reference(
+    positions: &[DVec3],
+    triangles: &[[u32; 3]],
+    face_n: &[u32],
+) -> (Vec<DVec3>, Vec<[u32; 3]>, Vec<u32>) {
+    let (mut points, mut subs, mut sub_faces) = (Vec::new(), Vec::new(), Vec::new());
+    for (f, t) in triangles.iter().enumerate() {
+        let (bary, sub) = face_grid(face_n[f]);
+        let offset = points.len() as u32;
+        let c = t.map(|v| positions[v as usize]);
+        points.extend(bary.iter().map(|w| w[0] * c[0] + w[1] * c[1] + w[2] * c[2]));
+        subs.extend(sub.iter().map(|s| s.map(|i| i + offset)));
+        sub_faces.extend(std::iter::repeat_n(f as u32, sub.len()));
+    }
+    (points, subs, sub_faces)
+}
+
+#[test]
+fn parallel_fill_matches_the_sequential_layout_whatever_the_thread_count() {
+    // 5120 faces: several parallel fill chunks with varied stochastic grid sizes.
+    let mesh = roar_mesh::shapes::icosphere(4);
+    let positions = mesh.positions().to_vec();
+    let triangles: Vec<[u32; 3]> = mesh
+        .faces()
+        .map(|f| mesh.face_vertices(f).map(|v| v.raw()))
+        .collect();
+    let options = RegularSamplingOptions {
+        density: 0.004,
+        ..Default::default()
+    };
+    let run = |threads: usize| {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap()
+            .install(|| sample(&positions, &triangles, &options, 3))
+    };
+    let one = run(1);
+    let two = run(2);
+    assert_eq!(one, two);
+    let sizes: std::collections::BTreeSet<u32> = one.face_n.iter().copied().collect();
+    assert!(
+        sizes.len() >= 2,
+        "stochastic rounding gives several sizes: {sizes:?}"
+    );
+    let (points, subs, sub_faces) = sequential_reference(&positions, &triangles, &one.face_n);
+    assert_eq!(one.points, points);
+    assert_eq!(one.sub_triangles, subs);
+    assert_eq!(one.sub_triangle_faces, sub_faces);
+    for f in 0..triangles.len() {
+        assert!(
+            one.faces[one.face_samples(f)]
+                .iter()
+                .all(|&g| g == f as u32)
+        );
+        assert_eq!(
+            one.barycentrics[one.face_samples(f)],
+            face_grid(one.face_n[f]).0[..]
+        );
+    }
+}
