@@ -8,7 +8,8 @@
 //! Algorithm: every live vertex gets the sum of the area-weighted plane quadrics of its faces;
 //! every edge gets the cost of merging its endpoints at the quadric's minimiser (or the best of
 //! the endpoints and the midpoint when the 3×3 system is singular). Edges are popped cheapest
-//! first from a heap with lazy invalidation (per-edge version stamps). A popped collapse must pass
+//! first from an indexed heap (one entry per edge, re-costed in place when a collapse changes
+//! its endpoints' quadrics). A popped collapse must pass
 //! the topological check of [`Mesh::can_collapse`] (link condition, no tetrahedron collapse) and
 //! the geometric vetoes, each counted in [`VetoCounts`]:
 //! - **normal flip**: the normal of a face around the merged vertex turns by `n·n' ≤
@@ -16,7 +17,8 @@
 //! - **quality**: a new face's aspect ratio `Q = R/(2r)` exceeds the current bound and the worst
 //!   of the replaced faces;
 //! - **self-intersection**: a new face intersects another face (exact test
-//!   [`faces_intersect`] against the faces a dynamic grid finds near it).
+//!   [`roar_mesh::spatial::faces_intersect`], behind certified floating-point plane-side
+//!   filters, against the other new faces and the faces a dynamic hashed grid finds near them).
 //!
 //! When the heap runs dry above the target, the edges are re-queued (vetoes are local, so
 //! collapses elsewhere may have unblocked them) and, when a whole pass makes no progress, the
@@ -24,15 +26,17 @@
 //! orientation and intersection vetoes are never relaxed.
 
 mod grid;
+mod heap;
+mod intersect;
 mod quadric;
 
 use glam::DVec3;
 use grid::FaceGrid;
+use heap::EdgeHeap;
+use intersect::faces_intersect_filtered;
 use quadric::{Quadric, placement};
-use roar_mesh::spatial::{Aabb, faces_intersect};
+use roar_mesh::spatial::Aabb;
 use roar_mesh::{Collapse, EdgeId, FaceId, HalfedgeId, Mesh, Remap, VertexId};
-use std::cmp::Ordering;
-use std::collections::BinaryHeap;
 use std::fmt;
 
 /// Options of [`decimate`]. `Default` gives the values used by the pipeline.
@@ -333,36 +337,6 @@ fn check_options(o: &DecimateOptions) -> Result<(), DecimateError> {
     Ok(())
 }
 
-/// A queued collapse of `edge` to `target` with quadric error `cost`, valid while the edge's
-/// version stamp equals `version`.
-#[derive(Debug, Clone, Copy)]
-struct Entry {
-    cost: f64,
-    edge: u32,
-    version: u32,
-    target: DVec3,
-}
-
-impl PartialEq for Entry {
-    fn eq(&self, o: &Self) -> bool {
-        self.cmp(o) == Ordering::Equal
-    }
-}
-impl Eq for Entry {}
-impl PartialOrd for Entry {
-    fn partial_cmp(&self, o: &Self) -> Option<Ordering> {
-        Some(self.cmp(o))
-    }
-}
-impl Ord for Entry {
-    /// Reversed, so the std max-heap pops the cheapest (ties: lowest edge id, deterministic).
-    fn cmp(&self, o: &Self) -> Ordering {
-        o.cost
-            .total_cmp(&self.cost)
-            .then_with(|| o.edge.cmp(&self.edge))
-    }
-}
-
 /// Why a collapse was refused.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 enum Veto {
@@ -387,18 +361,33 @@ struct Decimator<'m, F: FnMut(&Collapse)> {
     options: &'m DecimateOptions,
     on_collapse: F,
     quadrics: Vec<Quadric>,
-    versions: Vec<u32>,
-    heap: BinaryHeap<Entry>,
+    /// Placement of each queued edge's collapse (valid while the edge is in `heap`).
+    targets: Vec<DVec3>,
+    heap: EdgeHeap,
     grid: Option<FaceGrid>,
     grid_faces: usize,
+    /// Scratch: the corners (before the collapse) of the fan of the collapse being checked.
+    fan: Vec<[VertexId; 3]>,
+    /// Scratch: per-face stamp marking the fan and the two removed faces of the current check.
+    in_fan: Vec<u32>,
+    stamp: u32,
+    /// Scratch: the fan's faces after the collapse (relabelled corners) and their boxes.
+    fan_scratch: Vec<([u32; 3], Aabb)>,
+    /// Scratch: unmoved faces (corners, box) near the fan.
+    near_scratch: Vec<([u32; 3], Aabb)>,
     collapses: usize,
     vetoes: VetoCounts,
     passes: usize,
     max_cost: f64,
 }
 
-fn face_box(mesh: &Mesh, f: FaceId) -> Aabb {
-    Aabb::from_triangle(mesh.face_vertices(f).map(|v| mesh.position(v)))
+/// Corners of `f` as raw ids, and their box.
+fn face_corners_and_box(mesh: &Mesh, f: FaceId) -> ([u32; 3], Aabb) {
+    let c = mesh.face_vertices(f);
+    (
+        c.map(|v| v.raw()),
+        Aabb::from_triangle(c.map(|v| mesh.position(v))),
+    )
 }
 
 impl<'m, F: FnMut(&Collapse)> Decimator<'m, F> {
@@ -416,14 +405,19 @@ impl<'m, F: FnMut(&Collapse)> Decimator<'m, F> {
             }
         }
         let mut d = Decimator {
-            versions: vec![0; mesh.edge_capacity()],
+            targets: vec![DVec3::ZERO; mesh.edge_capacity()],
+            heap: EdgeHeap::new(mesh.edge_capacity()),
+            in_fan: vec![0; mesh.face_capacity()],
             mesh,
             options,
             on_collapse,
             quadrics,
-            heap: BinaryHeap::new(),
             grid: None,
             grid_faces: 0,
+            fan: Vec::new(),
+            stamp: 0,
+            fan_scratch: Vec::new(),
+            near_scratch: Vec::new(),
             collapses: 0,
             vetoes: VetoCounts::default(),
             passes: 0,
@@ -447,56 +441,51 @@ impl<'m, F: FnMut(&Collapse)> Decimator<'m, F> {
         } else {
             1.0
         };
-        let mut grid = FaceGrid::new(cell, mesh.face_capacity());
+        let mut grid = FaceGrid::new(cell, mesh.face_capacity(), mesh.n_faces());
         for f in mesh.faces() {
-            grid.insert(f.raw(), &face_box(mesh, f));
+            let (corners, bx) = face_corners_and_box(mesh, f);
+            grid.insert(f.raw(), corners, &bx);
         }
         self.grid = Some(grid);
         self.grid_faces = mesh.n_faces();
     }
 
-    fn push(&mut self, e: EdgeId) {
+    /// Cost and placement of collapsing `e` under the current quadrics; records the placement.
+    fn evaluate(&mut self, e: EdgeId) -> f64 {
         let [u, v] = self.mesh.edge_vertices(e);
         let q = self.quadrics[u.index()].add(&self.quadrics[v.index()]);
         let (target, cost) = placement(&q, self.mesh.position(u), self.mesh.position(v));
-        self.heap.push(Entry {
-            cost,
-            edge: e.raw(),
-            version: self.versions[e.index()],
-            target,
-        });
+        self.targets[e.index()] = target;
+        cost
     }
 
     /// One pass: queue every live edge, then collapse cheapest first until the target is
     /// reached or the heap is empty. Returns the vetoes of this pass.
     fn pass(&mut self, target_faces: usize, bound: f64) -> VetoCounts {
         self.passes += 1;
-        self.heap.clear();
         let edges: Vec<EdgeId> = self.mesh.edges().collect();
-        for e in edges {
-            self.versions[e.index()] = self.versions[e.index()].wrapping_add(1);
-            self.push(e);
-        }
+        let entries: Vec<(f64, u32)> = edges.iter().map(|&e| (self.evaluate(e), e.raw())).collect();
+        self.heap.rebuild(entries);
         let mut vetoes = VetoCounts::default();
         while self.mesh.n_faces() > target_faces {
-            let Some(entry) = self.heap.pop() else { break };
-            let e = EdgeId::from_index(entry.edge as usize);
-            if !self.mesh.is_edge_alive(e) || self.versions[e.index()] != entry.version {
-                continue;
-            }
+            let Some((cost, edge)) = self.heap.pop() else {
+                break;
+            };
+            let e = EdgeId::from_index(edge as usize);
             let h = e.halfedge();
             if self.mesh.can_collapse(h).is_err() {
                 vetoes.topology += 1;
                 continue;
             }
-            match self.geometric_veto(h, entry.target, bound) {
+            let target = self.targets[e.index()];
+            match self.geometric_veto(h, target, bound) {
                 Some(Veto::NormalFlip) => vetoes.normal_flip += 1,
                 Some(Veto::Degenerate) => vetoes.degenerate += 1,
                 Some(Veto::Quality) => vetoes.quality += 1,
                 Some(Veto::SelfIntersection) => vetoes.self_intersection += 1,
                 None => {
-                    self.apply(h, entry.target);
-                    self.max_cost = self.max_cost.max(entry.cost);
+                    self.apply(h, target);
+                    self.max_cost = self.max_cost.max(cost);
                 }
             }
         }
@@ -504,22 +493,41 @@ impl<'m, F: FnMut(&Collapse)> Decimator<'m, F> {
         vetoes
     }
 
-    /// The faces that survive a collapse of `h` and change shape: all faces around both
-    /// endpoints except the two on the edge.
-    fn fan(&self, h: HalfedgeId) -> Vec<FaceId> {
-        let (a, b) = (self.mesh.tail(h), self.mesh.head(h));
-        let gone = [self.mesh.face(h), self.mesh.face(h.twin())];
-        self.mesh
-            .faces_around(a)
-            .chain(self.mesh.faces_around(b))
-            .filter(|f| !gone.contains(f))
-            .collect()
+    /// Fills `self.fan` with the faces that survive a collapse of `h` and change shape (all
+    /// faces around both endpoints except the two on the edge), with their current corners,
+    /// and stamps them and the two removed faces in `in_fan`.
+    fn collect_fan(&mut self, h: HalfedgeId) {
+        let mesh = &*self.mesh;
+        let (a, b) = (mesh.tail(h), mesh.head(h));
+        self.stamp = self.stamp.wrapping_add(1);
+        if self.stamp == 0 {
+            self.in_fan.fill(0);
+            self.stamp = 1;
+        }
+        let stamp = self.stamp;
+        let gone = [mesh.face(h), mesh.face(h.twin())];
+        for f in gone {
+            self.in_fan[f.index()] = stamp;
+        }
+        self.fan.clear();
+        for v in [a, b] {
+            for o in mesh.outgoing(v) {
+                let face = mesh.face(o);
+                if gone.contains(&face) {
+                    continue;
+                }
+                // Outgoing `o: v → x` lies in the counter-clockwise face (v, x, head(next(o))).
+                let corners = [v, mesh.head(o), mesh.head(mesh.next(o))];
+                self.in_fan[face.index()] = stamp;
+                self.fan.push(corners);
+            }
+        }
     }
 
     fn geometric_veto(&mut self, h: HalfedgeId, p: DVec3, bound: f64) -> Option<Veto> {
+        self.collect_fan(h);
         let mesh = &*self.mesh;
         let (a, b) = (mesh.tail(h), mesh.head(h));
-        let fan = self.fan(h);
         let moved = |v: VertexId| {
             if v == a || v == b {
                 p
@@ -528,9 +536,9 @@ impl<'m, F: FnMut(&Collapse)> Decimator<'m, F> {
             }
         };
         let (mut q_old, mut q_new) = (1.0f64, 1.0f64);
-        for &f in &fan {
-            let old = mesh.face_vertices(f).map(|v| mesh.position(v));
-            let new = mesh.face_vertices(f).map(moved);
+        for corners in &self.fan {
+            let old = corners.map(|v| mesh.position(v));
+            let new = corners.map(moved);
             let cross_new = (new[1] - new[0]).cross(new[2] - new[0]);
             let longest = (0..3)
                 .map(|i| new[i].distance_squared(new[(i + 1) % 3]))
@@ -551,50 +559,59 @@ impl<'m, F: FnMut(&Collapse)> Decimator<'m, F> {
         if q_new > bound && q_new > q_old {
             return Some(Veto::Quality);
         }
-        if self.grid.is_some() && self.creates_intersection(h, p, &fan) {
+        if self.grid.is_some() && self.creates_intersection(h, p) {
             return Some(Veto::SelfIntersection);
         }
         None
     }
 
-    /// Whether a face of `fan` (with `tail(h)`, `head(h)` merged at `p`) intersects any other
-    /// face. Moves the two endpoints to `p` for the test and restores them.
-    fn creates_intersection(&mut self, h: HalfedgeId, p: DVec3, fan: &[FaceId]) -> bool {
+    /// Whether a face of the fan (with `tail(h)`, `head(h)` merged at `p`) intersects any
+    /// other face. Needs [`Self::collect_fan`] first. Moves the two endpoints to `p` for the
+    /// test and restores them.
+    ///
+    /// Faces outside the fan do not move: they are tested against each new fan face through
+    /// the grid (boxes stored in the grid are current for them). Fan faces are tested against
+    /// each other once per pair.
+    fn creates_intersection(&mut self, h: HalfedgeId, p: DVec3) -> bool {
         let (a, b) = (self.mesh.tail(h), self.mesh.head(h));
-        let gone = [self.mesh.face(h), self.mesh.face(h.twin())];
         let (pa, pb) = (self.mesh.position(a), self.mesh.position(b));
         self.mesh.set_position(a, p);
         self.mesh.set_position(b, p);
         let mesh = &*self.mesh;
         let grid = self.grid.as_mut().expect("grid exists when checking");
-        let relabel = |f: FaceId| {
-            mesh.face_vertices(f)
-                .map(|v| if v == a { b.raw() } else { v.raw() })
-        };
         let positions = mesh.positions();
+        let relabel = |c: [VertexId; 3]| c.map(|v| if v == a { b.raw() } else { v.raw() });
+        let (in_fan, stamp) = (&self.in_fan, self.stamp);
+        // The new fan faces with their boxes, and the box of them all.
+        let fan = &mut self.fan_scratch;
+        fan.clear();
+        let mut all = Aabb::EMPTY;
+        for &c in &self.fan {
+            let bx = Aabb::from_triangle(c.map(|v| positions[v.index()]));
+            all = all.union(&bx);
+            fan.push((relabel(c), bx));
+        }
+        // One grid query for the whole fan: the unmoved faces near it.
+        let near = &mut self.near_scratch;
+        near.clear();
+        grid.query(&all, |g, g_box, corners| {
+            if in_fan[g as usize] != stamp {
+                near.push((corners, *g_box));
+            }
+        });
         let mut hit = false;
-        let mut candidates = Vec::new();
-        for &f in fan {
-            let tri = relabel(f);
-            let bx = face_box(mesh, f);
-            candidates.clear();
-            grid.query(&bx, |g| candidates.push(g));
-            candidates.extend(fan.iter().map(|g| g.raw()));
-            for &g in &candidates {
-                let gf = FaceId::from_index(g as usize);
-                if gf == f || gone.contains(&gf) || !mesh.is_face_alive(gf) {
-                    continue;
-                }
-                if !face_box(mesh, gf).overlaps(&bx) {
-                    continue;
-                }
-                if faces_intersect(positions, tri, relabel(gf)) {
+        'fan: for (i, &(tri, bx)) in fan.iter().enumerate() {
+            for &(other, other_box) in &fan[i + 1..] {
+                if other_box.overlaps(&bx) && faces_intersect_filtered(positions, tri, other) {
                     hit = true;
-                    break;
+                    break 'fan;
                 }
             }
-            if hit {
-                break;
+            for &(other, g_box) in near.iter() {
+                if g_box.overlaps(&bx) && faces_intersect_filtered(positions, tri, other) {
+                    hit = true;
+                    break 'fan;
+                }
             }
         }
         self.mesh.set_position(a, pa);
@@ -613,18 +630,28 @@ impl<'m, F: FnMut(&Collapse)> Decimator<'m, F> {
         self.quadrics[b.index()] = q;
         self.collapses += 1;
         (self.on_collapse)(&c);
+        for e in c.removed_edges {
+            self.heap.remove(e.raw());
+        }
         if let Some(grid) = self.grid.as_mut() {
             for f in c.removed_faces {
                 grid.remove(f.raw());
             }
             for f in self.mesh.faces_around(b) {
-                grid.insert(f.raw(), &face_box(self.mesh, f));
+                let (corners, bx) = face_corners_and_box(self.mesh, f);
+                grid.insert(f.raw(), corners, &bx);
             }
         }
-        let around: Vec<EdgeId> = self.mesh.outgoing(b).map(|o| o.edge()).collect();
-        for e in around {
-            self.versions[e.index()] = self.versions[e.index()].wrapping_add(1);
-            self.push(e);
+        let start = self.mesh.halfedge_of_vertex(b);
+        let mut o = start;
+        loop {
+            let e = o.edge();
+            let cost = self.evaluate(e);
+            self.heap.set(e.raw(), cost);
+            o = self.mesh.prev(o).twin();
+            if o == start {
+                break;
+            }
         }
         if self.grid.is_some() && 2 * self.mesh.n_faces() < self.grid_faces {
             self.rebuild_grid();

@@ -1,0 +1,269 @@
+//! A filtered front end to the exact [`faces_intersect`]: cheap floating-point plane-side tests
+//! that are certain (Shewchuk's static error bound for `orient3d`) settle the common "clearly
+//! apart" cases without allocation; everything else goes to the exact test.
+
+use glam::DVec3;
+use roar_mesh::spatial::faces_intersect;
+
+/// Shewchuk's `o3derrboundA = (7 + 56ε)ε` with `ε = 2⁻⁵³`.
+const O3D_ERR_BOUND: f64 = (7.0 + 56.0 * f64::EPSILON / 2.0) * (f64::EPSILON / 2.0);
+
+/// The sign of `orient3d(a, b, c, d)` when the floating-point evaluation certifies it, else
+/// `None` (the exact value may be zero or of either sign). `Some(0)` is never returned.
+#[inline]
+fn certain_orient3d(a: DVec3, b: DVec3, c: DVec3, d: DVec3) -> Option<i8> {
+    let (ad, bd, cd) = (a - d, b - d, c - d);
+    let bdxcdy = bd.x * cd.y;
+    let cdxbdy = cd.x * bd.y;
+    let cdxady = cd.x * ad.y;
+    let adxcdy = ad.x * cd.y;
+    let adxbdy = ad.x * bd.y;
+    let bdxady = bd.x * ad.y;
+    let det = ad.z * (bdxcdy - cdxbdy) + bd.z * (cdxady - adxcdy) + cd.z * (adxbdy - bdxady);
+    let permanent = (bdxcdy.abs() + cdxbdy.abs()) * ad.z.abs()
+        + (cdxady.abs() + adxcdy.abs()) * bd.z.abs()
+        + (adxbdy.abs() + bdxady.abs()) * cd.z.abs();
+    let bound = O3D_ERR_BOUND * permanent;
+    if det > bound {
+        Some(1)
+    } else if -det > bound {
+        Some(-1)
+    } else {
+        None
+    }
+}
+
+/// Shewchuk's `ccwerrboundA = (3 + 16ε)ε` with `ε = 2⁻⁵³`.
+const O2D_ERR_BOUND: f64 = (3.0 + 16.0 * f64::EPSILON / 2.0) * (f64::EPSILON / 2.0);
+
+/// The sign of `orient2d(a, b, c)` on coordinates `(x, y) = (p[i], p[j])` when the
+/// floating-point evaluation certifies it, else `None`.
+#[inline]
+fn certain_orient2d(i: usize, j: usize, a: DVec3, b: DVec3, c: DVec3) -> Option<i8> {
+    let left = (a[i] - c[i]) * (b[j] - c[j]);
+    let right = (a[j] - c[j]) * (b[i] - c[i]);
+    let det = left - right;
+    let bound = O2D_ERR_BOUND * (left.abs() + right.abs());
+    if det > bound {
+        Some(1)
+    } else if -det > bound {
+        Some(-1)
+    } else {
+        None
+    }
+}
+
+/// The two coordinate axes kept when dropping the largest component of `n`.
+fn projection_axes(n: DVec3) -> (usize, usize) {
+    let a = n.abs();
+    if a.x >= a.y && a.x >= a.z {
+        (1, 2)
+    } else if a.y >= a.z {
+        (2, 0)
+    } else {
+        (0, 1)
+    }
+}
+
+/// A certified separating line in the projection on axes `(i, j)`: an edge `(p, q)` of one
+/// face, through every corner it shares with the other face, with the face's third corner
+/// strictly on one side and every unshared corner of the other face strictly on the other.
+///
+/// Why that proves the faces meet only in their shared corners: the projections then meet only
+/// on the edge's line, at projections of shared corners (or along the shared edge), and the
+/// projection is one-to-one on the first face (its projected area is certified non-zero).
+fn separated_in_projection(
+    (i, j): (usize, usize),
+    (ta, pa): ([u32; 3], [DVec3; 3]),
+    (tb, pb): ([u32; 3], [DVec3; 3]),
+    n_shared: usize,
+) -> bool {
+    for ((t, pt), (u, pu)) in [((ta, pa), (tb, pb)), ((tb, pb), (ta, pa))] {
+        'edges: for k in 0..3 {
+            let (p, q, r) = (k, (k + 1) % 3, (k + 2) % 3);
+            let on_edge = u.contains(&t[p]) as usize + u.contains(&t[q]) as usize;
+            if on_edge != n_shared {
+                continue;
+            }
+            let Some(side) = certain_orient2d(i, j, pt[p], pt[q], pt[r]) else {
+                continue;
+            };
+            for m in 0..3 {
+                if t.contains(&u[m]) {
+                    continue;
+                }
+                if certain_orient2d(i, j, pt[p], pt[q], pu[m]) != Some(-side) {
+                    continue 'edges;
+                }
+            }
+            return true;
+        }
+    }
+    false
+}
+
+/// True if every point of `points` is certainly strictly on one side of the plane `t`.
+#[inline]
+fn all_strictly_one_side(t: [DVec3; 3], points: &[DVec3]) -> bool {
+    let mut side = 0i8;
+    for &p in points {
+        match certain_orient3d(t[0], t[1], t[2], p) {
+            Some(s) if side == 0 || s == side => side = s,
+            _ => return false,
+        }
+    }
+    true
+}
+
+/// Same answer as [`faces_intersect`] whenever a face is not degenerate (collinear faces that
+/// `faces_intersect` conservatively reports may be reported only where they really meet).
+///
+/// Fast negatives, each certified by a floating-point filter with Shewchuk's error bounds: no
+/// shared index and one face strictly on one side of the other's plane; one shared index and
+/// the other two corners of one face strictly on one side of the other's plane (then the faces
+/// meet only at the shared corner); a shared edge whose two opposite corners are certainly not
+/// coplanar with it; and, for (near-)coplanar faces, a separating edge line in a coordinate
+/// projection (see `separated_in_projection`). Flat regions make the exact predicates take
+/// their slow, exact-arithmetic path, which these filters mostly avoid.
+pub(crate) fn faces_intersect_filtered(positions: &[DVec3], ta: [u32; 3], tb: [u32; 3]) -> bool {
+    let n = positions.len();
+    if ta.iter().chain(&tb).any(|&i| i as usize >= n) {
+        return faces_intersect(positions, ta, tb);
+    }
+    let pa = ta.map(|i| positions[i as usize]);
+    let pb = tb.map(|i| positions[i as usize]);
+    // Corners of each face that are not shared with the other.
+    let mut only_a = [DVec3::ZERO; 3];
+    let mut only_b = [DVec3::ZERO; 3];
+    let (mut na, mut nb) = (0, 0);
+    for i in 0..3 {
+        if !tb.contains(&ta[i]) {
+            only_a[na] = pa[i];
+            na += 1;
+        }
+        if !ta.contains(&tb[i]) {
+            only_b[nb] = pb[i];
+            nb += 1;
+        }
+    }
+    let apart = match (na, nb) {
+        (3, 3) | (2, 2) => {
+            all_strictly_one_side(pa, &only_b[..nb]) || all_strictly_one_side(pb, &only_a[..na])
+        }
+        // A shared edge: the opposite corners are off the plane of the other face.
+        (1, 1) => certain_orient3d(pa[0], pa[1], pa[2], only_b[0]).is_some(),
+        _ => return faces_intersect(positions, ta, tb),
+    };
+    if apart {
+        return false;
+    }
+    let n_shared = 3 - na;
+    let axes_a = projection_axes((pa[1] - pa[0]).cross(pa[2] - pa[0]));
+    let axes_b = projection_axes((pb[1] - pb[0]).cross(pb[2] - pb[0]));
+    if separated_in_projection(axes_a, (ta, pa), (tb, pb), n_shared)
+        || (axes_b != axes_a && separated_in_projection(axes_b, (ta, pa), (tb, pb), n_shared))
+    {
+        return false;
+    }
+    faces_intersect(positions, ta, tb)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rand::{Rng, SeedableRng};
+    use rand_chacha::ChaCha8Rng;
+
+    fn collinear(p: &[DVec3], t: [u32; 3]) -> bool {
+        let [a, b, c] = t.map(|i| p[i as usize]);
+        (b - a).cross(c - a) == DVec3::ZERO
+    }
+
+    /// On small integer coordinates (many exact coplanar and touching configurations) and
+    /// index triples sharing 0–3 indices, the filter agrees with the exact test whenever no face
+    /// is collinear.
+    #[test]
+    fn agrees_with_the_exact_test_on_non_degenerate_faces() {
+        let mut rng = ChaCha8Rng::seed_from_u64(11);
+        let mut checked = 0;
+        let mut hits = 0;
+        for _ in 0..300 {
+            let positions: Vec<DVec3> = (0..8)
+                .map(|_| {
+                    DVec3::new(
+                        rng.random_range(-2..=2) as f64,
+                        rng.random_range(-2..=2) as f64,
+                        rng.random_range(-2..=2) as f64,
+                    )
+                })
+                .collect();
+            for _ in 0..50 {
+                let mut pick = || {
+                    let mut t = [0u32; 3];
+                    loop {
+                        for x in &mut t {
+                            *x = rng.random_range(0..8);
+                        }
+                        if t[0] != t[1] && t[1] != t[2] && t[0] != t[2] {
+                            return t;
+                        }
+                    }
+                };
+                let (ta, tb) = (pick(), pick());
+                if collinear(&positions, ta) || collinear(&positions, tb) {
+                    continue;
+                }
+                let exact = faces_intersect(&positions, ta, tb);
+                assert_eq!(
+                    faces_intersect_filtered(&positions, ta, tb),
+                    exact,
+                    "{ta:?} {tb:?} {positions:?}"
+                );
+                checked += 1;
+                hits += exact as usize;
+            }
+        }
+        assert!(checked > 5000 && hits > 500, "{checked} pairs, {hits} hits");
+    }
+
+    #[test]
+    fn certain_signs_are_right_and_coplanar_points_are_uncertain() {
+        let (a, b, c) = (DVec3::ZERO, DVec3::X, DVec3::Y);
+        let up = certain_orient3d(a, b, c, DVec3::Z);
+        let down = certain_orient3d(a, b, c, -DVec3::Z);
+        assert!(up.is_some() && down.is_some() && up != down);
+        assert_eq!(certain_orient3d(a, b, c, DVec3::new(0.3, 0.7, 0.0)), None);
+        assert_eq!(certain_orient2d(0, 1, a, b, c), Some(1));
+        assert_eq!(certain_orient2d(0, 1, a, c, b), Some(-1));
+        assert_eq!(certain_orient2d(0, 1, a, b, 2.0 * b), None);
+    }
+
+    /// Coplanar fans (the flat regions where the exact predicates are slow): the filter agrees
+    /// with the exact test on faces sharing the apex or an edge, and on unrelated faces.
+    #[test]
+    fn agrees_with_the_exact_test_on_coplanar_faces() {
+        let mut rng = ChaCha8Rng::seed_from_u64(5);
+        let mut decided = 0;
+        for _ in 0..2000 {
+            // Points on the plane z = x/2 + y/4 (exact in binary), integer x, y.
+            let positions: Vec<DVec3> = (0..7)
+                .map(|_| {
+                    let (x, y) = (
+                        rng.random_range(-4..=4) as f64,
+                        rng.random_range(-4..=4) as f64,
+                    );
+                    DVec3::new(x, y, x / 2.0 + y / 4.0)
+                })
+                .collect();
+            let ta = [0, 1, 2];
+            let tb = [[0, 3, 4], [1, 0, 3], [4, 5, 6]][rng.random_range(0..3)];
+            if collinear(&positions, ta) || collinear(&positions, tb) {
+                continue;
+            }
+            let exact = faces_intersect(&positions, ta, tb);
+            assert_eq!(faces_intersect_filtered(&positions, ta, tb), exact);
+            decided += (!exact) as usize;
+        }
+        assert!(decided > 300);
+    }
+}
