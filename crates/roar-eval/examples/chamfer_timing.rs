@@ -6,32 +6,6 @@ use std::time::Instant;
 use glam::DVec3;
 use roar_eval::{ChamferOptions, EvalOptions, evaluate, fidelity, topology};
 
-fn load_obj(path: &str) -> (Vec<DVec3>, Vec<[u32; 3]>) {
-    let text = std::fs::read_to_string(path).expect("readable OBJ");
-    let (mut p, mut t) = (Vec::new(), Vec::new());
-    for line in text.lines() {
-        let w: Vec<&str> = line.split_whitespace().collect();
-        match w.first() {
-            Some(&"v") => p.push(DVec3::new(
-                w[1].parse().unwrap(),
-                w[2].parse().unwrap(),
-                w[3].parse().unwrap(),
-            )),
-            Some(&"f") => {
-                let i: Vec<u32> = w[1..]
-                    .iter()
-                    .map(|s| s.split('/').next().unwrap().parse::<u32>().unwrap() - 1)
-                    .collect();
-                for k in 1..i.len() - 1 {
-                    t.push([i[0], i[k], i[k + 1]]);
-                }
-            }
-            _ => {}
-        }
-    }
-    (p, t)
-}
-
 /// CPU seconds used by the whole process so far (all threads; Linux `/proc/self/stat`, 100 Hz ticks).
 fn cpu_seconds() -> f64 {
     let stat = std::fs::read_to_string("/proc/self/stat").unwrap_or_default();
@@ -52,7 +26,8 @@ fn main() {
         std::env::var("ROAR_TEST_DATA").expect("give a file or set ROAR_TEST_DATA")
             + "/clean/armadillo.obj"
     });
-    let (p, t) = load_obj(&path);
+    let soup = roar_io::read_mesh(std::path::Path::new(&path)).unwrap_or_else(|e| panic!("{e}"));
+    let (p, t) = (soup.positions, soup.triangles);
     let shifted: Vec<DVec3> = p.iter().map(|q| *q * 1.01).collect();
     println!(
         "{path}: {} vertices, {} faces, threads {}",

@@ -19,7 +19,8 @@ fn wild_soups_give_clean_targets_and_point_clouds() {
         "manifoldplus-chair.off",
         "trimesh-rabbit.obj",
     ] {
-        let (positions, triangles) = common::read_mesh(&dir.join(name));
+        let soup = roar_io::read_mesh(&dir.join(name)).unwrap_or_else(|e| panic!("{e}"));
+        let (positions, triangles) = (soup.positions, soup.triangles);
         let (start, cpu) = (Instant::now(), common::cpu_seconds());
         let target = build_target(&positions, &triangles, &TargetOptions::default()).unwrap();
         let build_time = start.elapsed();

@@ -59,7 +59,8 @@ fn main() {
     }
     println!("rayon threads: {}", rayon::current_num_threads());
     for name in names {
-        let (positions, triangles) = spatial_common::read_mesh(&dir.join(&name));
+        let soup = roar_io::read_mesh(&dir.join(&name)).unwrap_or_else(|e| panic!("{e}"));
+        let (positions, triangles) = (soup.positions, soup.triangles);
         let (bvh, build) = timed(|| TriangleBvh::build(&positions, &triangles));
 
         // Queries off the surface along the normal by 0.1 % and 1 % of the box diagonal.

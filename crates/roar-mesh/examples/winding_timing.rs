@@ -7,72 +7,9 @@
 use glam::DVec3;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
+use roar_mesh::shapes::icosphere;
 use roar_mesh::spatial::{WindingNumber, WindingNumberOptions, exact_winding_number};
-use std::collections::HashMap;
 use std::time::Instant;
-
-/// Unit icosphere with `levels` 1→4 subdivisions, outward oriented.
-fn icosphere(levels: u32) -> (Vec<DVec3>, Vec<[u32; 3]>) {
-    let t = (1.0 + 5f64.sqrt()) / 2.0;
-    let mut positions: Vec<DVec3> = [
-        (-1.0, t, 0.0),
-        (1.0, t, 0.0),
-        (-1.0, -t, 0.0),
-        (1.0, -t, 0.0),
-        (0.0, -1.0, t),
-        (0.0, 1.0, t),
-        (0.0, -1.0, -t),
-        (0.0, 1.0, -t),
-        (t, 0.0, -1.0),
-        (t, 0.0, 1.0),
-        (-t, 0.0, -1.0),
-        (-t, 0.0, 1.0),
-    ]
-    .iter()
-    .map(|&(x, y, z)| DVec3::new(x, y, z).normalize())
-    .collect();
-    let mut triangles: Vec<[u32; 3]> = vec![
-        [0, 11, 5],
-        [0, 5, 1],
-        [0, 1, 7],
-        [0, 7, 10],
-        [0, 10, 11],
-        [1, 5, 9],
-        [5, 11, 4],
-        [11, 10, 2],
-        [10, 7, 6],
-        [7, 1, 8],
-        [3, 9, 4],
-        [3, 4, 2],
-        [3, 2, 6],
-        [3, 6, 8],
-        [3, 8, 9],
-        [4, 9, 5],
-        [2, 4, 11],
-        [6, 2, 10],
-        [8, 6, 7],
-        [9, 8, 1],
-    ];
-    for _ in 0..levels {
-        let mut midpoints: HashMap<(u32, u32), u32> = HashMap::new();
-        let mut midpoint = |a: u32, b: u32, positions: &mut Vec<DVec3>| {
-            let key = (a.min(b), a.max(b));
-            *midpoints.entry(key).or_insert_with(|| {
-                positions.push(((positions[a as usize] + positions[b as usize]) / 2.0).normalize());
-                (positions.len() - 1) as u32
-            })
-        };
-        let mut next = Vec::with_capacity(triangles.len() * 4);
-        for [a, b, c] in triangles {
-            let ab = midpoint(a, b, &mut positions);
-            let bc = midpoint(b, c, &mut positions);
-            let ca = midpoint(c, a, &mut positions);
-            next.extend([[a, ab, ca], [b, bc, ab], [c, ca, bc], [ab, bc, ca]]);
-        }
-        triangles = next;
-    }
-    (positions, triangles)
-}
 
 /// User + system CPU seconds of this process (Linux `/proc/self/stat`, 100 ticks per second),
 /// so timings stay meaningful on a shared, loaded machine.
@@ -96,7 +33,7 @@ fn main() {
     let queries: usize = args.get(2).and_then(|s| s.parse().ok()).unwrap_or(200_000);
     let beta: f64 = args.get(3).and_then(|s| s.parse().ok()).unwrap_or(2.0);
     let leaf_size: usize = args.get(4).and_then(|s| s.parse().ok()).unwrap_or(8);
-    let (positions, triangles) = icosphere(levels);
+    let (positions, triangles) = icosphere(levels).to_triangles();
     println!(
         "mesh: {} triangles, {} queries, beta {beta}, {} rayon threads",
         triangles.len(),

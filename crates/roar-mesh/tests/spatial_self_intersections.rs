@@ -99,7 +99,8 @@ fn octahedron_is_clean_until_a_plane_cuts_it() {
 
 fn count_on(name: &str) -> Option<(usize, usize)> {
     let dir = spatial_common::test_data_dir()?;
-    let (positions, triangles) = spatial_common::read_mesh(&dir.join("clean").join(name));
+    let soup = roar_io::read_mesh(&dir.join("clean").join(name)).unwrap_or_else(|e| panic!("{e}"));
+    let (positions, triangles) = (soup.positions, soup.triangles);
     let flags = self_intersecting_faces(&positions, &triangles);
     Some((flags.iter().filter(|&&f| f).count(), triangles.len()))
 }

@@ -4,71 +4,8 @@ use glam::DVec3;
 use proptest::prelude::*;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
+use roar_mesh::shapes::icosphere;
 use roar_mesh::spatial::{WindingNumber, WindingNumberOptions, exact_winding_number};
-use std::collections::HashMap;
-
-/// Unit icosphere with `levels` 1→4 subdivisions, outward oriented.
-fn icosphere(levels: u32) -> (Vec<DVec3>, Vec<[u32; 3]>) {
-    let t = (1.0 + 5f64.sqrt()) / 2.0;
-    let mut positions: Vec<DVec3> = [
-        (-1.0, t, 0.0),
-        (1.0, t, 0.0),
-        (-1.0, -t, 0.0),
-        (1.0, -t, 0.0),
-        (0.0, -1.0, t),
-        (0.0, 1.0, t),
-        (0.0, -1.0, -t),
-        (0.0, 1.0, -t),
-        (t, 0.0, -1.0),
-        (t, 0.0, 1.0),
-        (-t, 0.0, -1.0),
-        (-t, 0.0, 1.0),
-    ]
-    .iter()
-    .map(|&(x, y, z)| DVec3::new(x, y, z).normalize())
-    .collect();
-    let mut triangles: Vec<[u32; 3]> = vec![
-        [0, 11, 5],
-        [0, 5, 1],
-        [0, 1, 7],
-        [0, 7, 10],
-        [0, 10, 11],
-        [1, 5, 9],
-        [5, 11, 4],
-        [11, 10, 2],
-        [10, 7, 6],
-        [7, 1, 8],
-        [3, 9, 4],
-        [3, 4, 2],
-        [3, 2, 6],
-        [3, 6, 8],
-        [3, 8, 9],
-        [4, 9, 5],
-        [2, 4, 11],
-        [6, 2, 10],
-        [8, 6, 7],
-        [9, 8, 1],
-    ];
-    for _ in 0..levels {
-        let mut midpoints: HashMap<(u32, u32), u32> = HashMap::new();
-        let mut midpoint = |a: u32, b: u32, positions: &mut Vec<DVec3>| {
-            let key = (a.min(b), a.max(b));
-            *midpoints.entry(key).or_insert_with(|| {
-                positions.push(((positions[a as usize] + positions[b as usize]) / 2.0).normalize());
-                (positions.len() - 1) as u32
-            })
-        };
-        let mut next = Vec::with_capacity(triangles.len() * 4);
-        for [a, b, c] in triangles {
-            let ab = midpoint(a, b, &mut positions);
-            let bc = midpoint(b, c, &mut positions);
-            let ca = midpoint(c, a, &mut positions);
-            next.extend([[a, ab, ca], [b, bc, ab], [c, ca, bc], [ab, bc, ca]]);
-        }
-        triangles = next;
-    }
-    (positions, triangles)
-}
 
 /// Axis-aligned cube [0,1]³, 12 outward-oriented triangles.
 fn cube() -> (Vec<DVec3>, Vec<[u32; 3]>) {
@@ -110,7 +47,7 @@ fn random_points(rng: &mut ChaCha8Rng, count: usize, half_extent: f64) -> Vec<DV
 
 #[test]
 fn closed_sphere_is_one_inside_and_zero_outside() {
-    let (p, t) = icosphere(3);
+    let (p, t) = icosphere(3).to_triangles();
     let wn = WindingNumber::build(&p, &t).unwrap();
     for q in [
         DVec3::ZERO,
@@ -142,7 +79,7 @@ fn closed_cube_is_one_inside_and_zero_outside() {
 
 #[test]
 fn reversed_orientation_gives_minus_one_inside() {
-    let (p, t) = icosphere(2);
+    let (p, t) = icosphere(2).to_triangles();
     let t = reversed(&t);
     let wn = WindingNumber::build(&p, &t).unwrap();
     assert!((wn.winding_number(DVec3::new(0.1, 0.2, 0.3)) + 1.0).abs() < 1e-2);
@@ -152,7 +89,7 @@ fn reversed_orientation_gives_minus_one_inside() {
 
 #[test]
 fn open_hemisphere_gives_fractional_values() {
-    let (p, t) = icosphere(3);
+    let (p, t) = icosphere(3).to_triangles();
     // Keep the upper half: faces whose centroid has z > 0.
     let upper: Vec<[u32; 3]> = t
         .iter()
@@ -206,7 +143,7 @@ fn doubled_sheet_is_zero_everywhere() {
 
 #[test]
 fn batch_query_matches_single_queries_bit_for_bit() {
-    let (p, t) = icosphere(3);
+    let (p, t) = icosphere(3).to_triangles();
     let wn = WindingNumber::build(&p, &t).unwrap();
     let mut rng = ChaCha8Rng::seed_from_u64(3);
     let points = random_points(&mut rng, 5000, 1.5);
@@ -220,7 +157,7 @@ fn batch_query_matches_single_queries_bit_for_bit() {
 
 #[test]
 fn fast_matches_exact_on_subdivided_sphere_including_near_surface() {
-    let (p, t) = icosphere(4);
+    let (p, t) = icosphere(4).to_triangles();
     let wn = WindingNumber::build(&p, &t).unwrap();
     let mut rng = ChaCha8Rng::seed_from_u64(11);
     let mut points = random_points(&mut rng, 300, 2.0);
@@ -243,7 +180,7 @@ fn fast_matches_exact_on_subdivided_sphere_including_near_surface() {
 
 #[test]
 fn larger_beta_is_at_least_as_accurate_on_average() {
-    let (p, t) = icosphere(3);
+    let (p, t) = icosphere(3).to_triangles();
     let mut rng = ChaCha8Rng::seed_from_u64(5);
     let points = random_points(&mut rng, 400, 1.5);
     let exact: Vec<f64> = points

@@ -2,35 +2,15 @@
 //! with at most 20k faces, no self-intersecting face, positive volume and Chamfer/diag < 0.01 to
 //! the input. Prints one row per mesh (time, init faces, final faces, Chamfer/diag).
 
+mod common;
+
+use common::data_dir;
 use roar_eval::{ChamferOptions, fidelity};
 use roar_io::read_mesh;
 use roar_mesh::spatial::self_intersecting_faces;
 use roar_ops::init::{InitialMeshOptions, initial_mesh};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
-
-/// The data folder, or `None` (test passes with a note) when `ROAR_TEST_DATA` is unset outside CI.
-fn data_dir() -> Option<PathBuf> {
-    match std::env::var("ROAR_TEST_DATA") {
-        Ok(dir) => {
-            let dir = PathBuf::from(dir);
-            assert!(
-                dir.join("clean").is_dir() && dir.join("wild").is_dir(),
-                "ROAR_TEST_DATA={} has no clean/ and wild/",
-                dir.display()
-            );
-            Some(dir)
-        }
-        Err(_) => {
-            assert!(
-                std::env::var("CI").as_deref() != Ok("true"),
-                "ROAR_TEST_DATA must be set in CI"
-            );
-            eprintln!("note: ROAR_TEST_DATA unset; skipping real-data test");
-            None
-        }
-    }
-}
 
 fn check_file(path: &Path) {
     let name = path.file_name().unwrap().to_string_lossy().to_string();

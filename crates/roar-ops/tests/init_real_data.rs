@@ -4,35 +4,12 @@
 
 mod common;
 
-use common::{check_closed_manifold, load};
+use common::{check_closed_manifold, data_dir};
 use glam::DVec3;
 use roar_mesh::spatial::TriangleBvh;
 use roar_ops::init::{InitOptions, watertight_init};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
-
-/// The data folder, or `None` (test passes with a note) when `ROAR_TEST_DATA` is unset outside CI.
-fn data_dir() -> Option<PathBuf> {
-    match std::env::var("ROAR_TEST_DATA") {
-        Ok(dir) => {
-            let dir = PathBuf::from(dir);
-            assert!(
-                dir.join("clean").is_dir() && dir.join("wild").is_dir(),
-                "ROAR_TEST_DATA={} has no clean/ and wild/",
-                dir.display()
-            );
-            Some(dir)
-        }
-        Err(_) => {
-            assert!(
-                std::env::var("CI").as_deref() != Ok("true"),
-                "ROAR_TEST_DATA must be set in CI"
-            );
-            eprintln!("note: ROAR_TEST_DATA unset; skipping real-data test");
-            None
-        }
-    }
-}
 
 fn mean_distance(grid: &TriangleBvh, points: &[DVec3]) -> f64 {
     points
@@ -44,7 +21,7 @@ fn mean_distance(grid: &TriangleBvh, points: &[DVec3]) -> f64 {
 
 /// Runs the init on one file, checks it, prints a row and returns the output → soup distance / diag.
 fn check_file(path: &Path) -> f64 {
-    let soup = load(path);
+    let soup = roar_io::read_mesh(path).unwrap_or_else(|e| panic!("{e}"));
     let start = Instant::now();
     let out = watertight_init(&soup.positions, &soup.triangles, &InitOptions::default())
         .unwrap_or_else(|e| panic!("{}: {e}", path.display()));

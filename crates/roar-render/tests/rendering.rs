@@ -4,13 +4,14 @@
 mod support;
 
 use glam::DVec3;
+use roar_mesh::shapes::icosphere;
 use roar_render::camera::ProjectedVertex;
 use roar_render::raster::rasterize;
 use roar_render::{
     BACKGROUND, LossKind, RenderError, RenderOptions, face_pixel_counts, render,
     render_loss_and_grad, star_cameras, to_rgba8,
 };
-use support::{Rng, bumpy_sphere, icosphere};
+use support::{Rng, bumpy_sphere};
 
 fn pv(x: f64, y: f64) -> ProjectedVertex {
     ProjectedVertex {
@@ -159,7 +160,7 @@ fn rendering_determinism_under_triangle_order_and_thread_count() {
 #[test]
 fn culling_and_face_pixel_counts_pick_the_outward_twin_of_a_soup() {
     // An outward sphere plus every face's reversed twin (faces n..2n).
-    let (pos, tris) = icosphere(2);
+    let (pos, tris) = icosphere(2).to_triangles();
     let n = tris.len();
     let mut soup = tris.clone();
     soup.extend(tris.iter().map(|t| [t[0], t[2], t[1]]));
@@ -187,7 +188,7 @@ fn culling_and_face_pixel_counts_pick_the_outward_twin_of_a_soup() {
 
 #[test]
 fn flat_shading_writes_raw_normals_and_alpha() {
-    let (pos, tris) = icosphere(1);
+    let (pos, tris) = icosphere(1).to_triangles();
     let cams = star_cameras(1, 1, 32, 32);
     let r = render(
         &pos,
@@ -259,7 +260,7 @@ fn bad_input_gives_errors_not_garbage() {
 
 #[test]
 fn optimization_smoke_sphere_to_ellipsoid_halves_the_loss() {
-    let (sphere, tris) = icosphere(3);
+    let (sphere, tris) = icosphere(3).to_triangles();
     let cams = star_cameras(3, 2, 64, 64);
     let opts = RenderOptions::default();
     let ellipsoid: Vec<DVec3> = sphere

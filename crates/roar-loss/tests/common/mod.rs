@@ -1,4 +1,4 @@
-//! Test support for roar-loss: procedural shapes and a tiny OBJ/OFF reader for the real meshes.
+//! Test support for roar-loss: procedural shapes, random numbers and where the real meshes live.
 #![allow(dead_code)]
 
 use glam::DVec3;
@@ -117,61 +117,6 @@ pub fn wild_dir() -> Option<PathBuf> {
             None
         }
     }
-}
-
-/// Reads an OBJ (`v`, `f` with fan-triangulated polygons, `a/b/c` and negative indices) or OFF
-/// file into positions and triangles. Test-only: no error recovery.
-pub fn read_mesh(path: &std::path::Path) -> (Vec<DVec3>, Vec<[u32; 3]>) {
-    let text = std::fs::read_to_string(path).unwrap();
-    let mut p = Vec::new();
-    let mut t = Vec::new();
-    let fan = |poly: &[u32], t: &mut Vec<[u32; 3]>| {
-        for k in 1..poly.len().saturating_sub(1) {
-            t.push([poly[0], poly[k], poly[k + 1]]);
-        }
-    };
-    if path
-        .extension()
-        .is_some_and(|e| e.eq_ignore_ascii_case("off"))
-    {
-        let mut nums = text
-            .lines()
-            .map(|l| l.split('#').next().unwrap())
-            .flat_map(str::split_whitespace)
-            .skip_while(|w| w.ends_with("OFF"));
-        let mut next = || nums.next().unwrap().parse::<f64>().unwrap();
-        let (nv, nf, _) = (next() as usize, next() as usize, next());
-        for _ in 0..nv {
-            p.push(DVec3::new(next(), next(), next()));
-        }
-        for _ in 0..nf {
-            let n = next() as usize;
-            let poly: Vec<u32> = (0..n).map(|_| next() as u32).collect();
-            fan(&poly, &mut t);
-            // Optional per-face colours are not supported (none in the files used here).
-        }
-    } else {
-        for line in text.lines() {
-            let mut w = line.split_whitespace();
-            match w.next() {
-                Some("v") => {
-                    let c: Vec<f64> = w.take(3).map(|x| x.parse().unwrap()).collect();
-                    p.push(DVec3::new(c[0], c[1], c[2]));
-                }
-                Some("f") => {
-                    let poly: Vec<u32> = w
-                        .map(|x| {
-                            let i: i64 = x.split('/').next().unwrap().parse().unwrap();
-                            (if i < 0 { p.len() as i64 + i } else { i - 1 }) as u32
-                        })
-                        .collect();
-                    fan(&poly, &mut t);
-                }
-                _ => {}
-            }
-        }
-    }
-    (p, t)
 }
 
 /// CPU seconds (user + system) used by this process so far, from `/proc/self/stat` (Linux;
