@@ -37,7 +37,10 @@ fn check_file(path: &Path) {
         .count();
     assert_eq!(crossing, 0, "{name}: {crossing} self-intersecting faces");
     let chamfer_options = ChamferOptions {
-        samples: 20_000,
+        // 20k samples a side put the sampling floor near 0.002 of the diagonal (manifoldplus-bed
+        // measured 0.0103 at 20k and 0.0083 at 100k): measure with 100k so the 0.01 bound judges
+        // the surface, not the sampling.
+        samples: 100_000,
         seed: 7,
     };
     let f = fidelity(
