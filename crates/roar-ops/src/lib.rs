@@ -9,6 +9,7 @@ pub mod collapse_block;
 pub mod flips;
 pub mod geometry;
 pub mod init;
+mod intersect;
 pub mod optim;
 pub mod qem;
 pub mod qslim;

@@ -27,13 +27,12 @@
 
 mod grid;
 mod heap;
-mod intersect;
 mod quadric;
 
+use crate::intersect::faces_intersect_filtered;
 use glam::DVec3;
 use grid::FaceGrid;
 use heap::EdgeHeap;
-use intersect::faces_intersect_filtered;
 use quadric::{Quadric, placement};
 use roar_mesh::spatial::Aabb;
 use roar_mesh::{Collapse, EdgeId, FaceId, HalfedgeId, Mesh, Remap, VertexId};

@@ -5,7 +5,7 @@
 //! and the piece count are kept) and a simulation on the current buffers shows that it strictly
 //! lowers the number of intersecting pairs around it and flips no remaining face.
 
-use super::exact::faces_cross;
+use crate::intersect::faces_intersect_filtered as faces_cross;
 use glam::DVec3;
 use roar_mesh::spatial::{Aabb, TriangleBvh};
 use roar_mesh::{FaceId, HalfedgeId, Mesh, VertexId};

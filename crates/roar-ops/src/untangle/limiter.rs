@@ -1,6 +1,6 @@
 //! The step limiter: shortens optimizer steps that would create a self-intersection.
 
-use super::exact::faces_cross;
+use crate::intersect::faces_intersect_filtered as faces_cross;
 use glam::DVec3;
 use roar_mesh::spatial::{Aabb, TriangleBvh};
 
@@ -51,7 +51,7 @@ pub struct LimiterStats {
 ///
 /// Cost: one BVH clone and refit per pass plus, for the changed faces, a box query and the
 /// exact tests (adjacent pairs are mostly settled by floating-point filters, see
-/// `exact::faces_cross`). Invalid indices are ignored; non-finite proposals are cancelled.
+/// `crate::intersect::faces_intersect_filtered`). Invalid indices are ignored; non-finite proposals are cancelled.
 pub fn limit_steps(
     before: &[DVec3],
     proposed: &mut [DVec3],

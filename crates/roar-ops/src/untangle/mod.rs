@@ -22,7 +22,6 @@
 //! move up to `max_halvings` times and cancelling it if its faces would intersect the mesh.
 
 mod collapse;
-mod exact;
 mod limiter;
 mod pairs;
 mod resolve;

@@ -1,6 +1,6 @@
 //! Incremental self-intersection detection across the rounds of [`super::untangle`].
 
-use super::exact::faces_cross;
+use crate::intersect::faces_intersect_filtered as faces_cross;
 use glam::DVec3;
 use roar_mesh::spatial::{Aabb, TriangleBvh, intersecting_pairs};
 

@@ -1,6 +1,7 @@
 //! A filtered front end to the exact [`faces_intersect`]: cheap floating-point plane-side tests
 //! that are certain (Shewchuk's static error bound for `orient3d`) settle the common "clearly
-//! apart" cases without allocation; everything else goes to the exact test.
+//! apart" cases without allocation; everything else goes to the exact test. Shared by the QEM
+//! intersection veto, the untangle block and the step limiter, which test many face pairs.
 
 use glam::DVec3;
 use roar_mesh::spatial::faces_intersect;
