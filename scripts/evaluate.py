@@ -282,6 +282,28 @@ def write_json(results, path):
 # ---------------------------------------------------------------------------------------------
 
 
+def earlier_rows(path, args, methods):
+    """Rows of methods not run now, from an earlier run into the same folder with the same
+    budgets and sample count, so the peers and roar can be run (and rerun) separately."""
+    try:
+        with open(path) as f:
+            earlier = json.load(f)
+    except (OSError, ValueError):
+        return {}
+    if earlier.get("budgets") != args.budgets or earlier.get("samples") != args.samples:
+        log("not keeping rows of %s: other budgets or sample count" % path)
+        return {}
+    kept = {}
+    for name, per_method in earlier.get("meshes", {}).items():
+        rows = {m: e for m, e in per_method.items() if m not in methods}
+        if rows:
+            kept[name] = rows
+    if kept:
+        log("keeping rows of %s from %s" % (
+            " ".join(sorted({m for r in kept.values() for m in r})), path))
+    return kept
+
+
 def main():
     parser = argparse.ArgumentParser(description="roar vs peers; see docs/evaluation.md")
     parser.add_argument("--roar", required=True, help="the roar binary")
@@ -315,11 +337,12 @@ def main():
         "roar": args.roar,
         "meshes": {},
     }
+    kept = earlier_rows(os.path.join(args.out, "results.json"), args, methods)
     log("%d meshes, budgets %s, methods %s" % (len(meshes), args.budgets, " ".join(methods)))
     for mesh in meshes:
         name = os.path.basename(mesh)
         work = os.path.join(args.out, "meshes", name)
-        per_method = {}
+        per_method = dict(kept.get(name, {}))
         for method in methods:
             workdir = os.path.join(work, method)
             if method == "roar":
