@@ -25,6 +25,7 @@ fn toy_config(faces: usize) -> ReconstructConfig {
 
 fn run(config: ReconstructConfig) -> (Vec<glam::DVec3>, Vec<[u32; 3]>, usize) {
     let soup = roar_cli::example::chair_soup();
+    let config_iterations = config.iterations;
     let mut stages = Vec::new();
     let out = Reconstruction::new(config)
         .run(&soup.positions, &soup.triangles, &mut |p| {
@@ -33,6 +34,14 @@ fn run(config: ReconstructConfig) -> (Vec<glam::DVec3>, Vec<[u32; 3]>, usize) {
         .unwrap();
     for stage in ["target", "init", "optimize", "decimate"] {
         assert!(stages.contains(&stage), "progress never reported {stage}");
+    }
+    // The report's history has one record per iteration whose terms add up to the loss.
+    assert_eq!(out.stats.history.len(), config_iterations);
+    for record in &out.stats.history {
+        let names: Vec<&str> = record.terms.keys().copied().collect();
+        assert_eq!(names, ["planar", "render"]);
+        let sum: f64 = record.terms.values().sum();
+        assert!((sum - record.loss).abs() <= 1e-12 * record.loss.abs().max(1.0));
     }
     (out.positions, out.triangles, out.stats.init_components)
 }

@@ -53,6 +53,12 @@ pub trait Loss: Send {
         positions: &[DVec3],
         triangles: &[[u32; 3]],
     ) -> Result<(f64, Vec<DVec3>), LossError>;
+
+    /// The weighted value of each term of the last evaluation, by name, for reports (a loss
+    /// made of one term returns nothing: its value is the total).
+    fn last_terms(&self) -> Vec<(&'static str, f64)> {
+        Vec::new()
+    }
 }
 
 /// A weighted sum of losses, itself a [`Loss`] (spec §3.2.3: `3·L_render + 1·L_planar`).
@@ -95,6 +101,14 @@ impl Loss for WeightedSum {
         }
         Ok((total, gradient))
     }
+
+    fn last_terms(&self) -> Vec<(&'static str, f64)> {
+        self.terms
+            .iter()
+            .zip(&self.last_values)
+            .map(|((_, loss), &value)| (loss.name(), value))
+            .collect()
+    }
 }
 
 #[cfg(test)]
@@ -128,6 +142,10 @@ mod tests {
         // Σ|v|² = 6; 3·6 + 0.5·2·6 = 24.
         assert_eq!(value, 24.0);
         assert_eq!(sum.last_values, vec![18.0, 6.0]);
+        assert_eq!(
+            sum.last_terms(),
+            vec![("quadratic", 18.0), ("quadratic", 6.0)]
+        );
         // 3·2v + 0.5·4v = 8v.
         assert_eq!(grad[0], 8.0 * positions[0]);
         assert_eq!(grad[1], 8.0 * positions[1]);

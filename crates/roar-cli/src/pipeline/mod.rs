@@ -125,8 +125,8 @@ pub struct RunStats {
     pub loss_first: f64,
     /// See `loss_first`.
     pub loss_last: f64,
-    /// Loss and face count at every iteration.
-    pub history: Vec<(f64, usize)>,
+    /// Loss, its terms and the face count at every iteration.
+    pub history: Vec<IterationRecord>,
     /// Faces after the optimization loop.
     pub loop_faces: usize,
     /// Accepted operations per block over the loop, by block name.
@@ -141,6 +141,17 @@ pub struct RunStats {
     pub untangle_rounds: usize,
     /// Collapses of the final QEM.
     pub final_collapses: usize,
+}
+
+/// One iteration of the optimize stage, as the report lists it.
+#[derive(Debug, Clone, Default, Serialize)]
+pub struct IterationRecord {
+    /// The loss before the step.
+    pub loss: f64,
+    /// The weighted value of each term of the loss (empty for a one-term loss).
+    pub terms: BTreeMap<&'static str, f64>,
+    /// Faces when the loss was evaluated.
+    pub faces: usize,
 }
 
 /// The output of a run: the mesh in the input's coordinates.
@@ -261,7 +272,11 @@ impl Reconstruction {
                 stats.loss_first = value;
             }
             stats.loss_last = value;
-            stats.history.push((value, mesh.n_faces()));
+            stats.history.push(IterationRecord {
+                loss: value,
+                terms: loss.last_terms().into_iter().collect(),
+                faces: mesh.n_faces(),
+            });
             clock.lap("loop_loss");
             let before = config.step_limiter.then(|| mesh.positions().to_vec());
             optimizer
