@@ -53,17 +53,41 @@ impl Default for FaceCollapseOptions {
 }
 
 /// Faces flagged by the fold estimator of §3.6 step 1 (note 4), by face slot.
+///
+/// With the normal-size gate on, a flagged face whose vertex normals diverge (`|n_o(f)|` below
+/// the gate) is spared unless it turns back on a neighbour ([`folds_onto_a_neighbour`]): the
+/// gate is meant for creases and thin parts, whose sharp edges are convex, and a fold's vertex
+/// normals diverge too [INF].
 pub fn flagged_faces(mesh: &Mesh, geometry: &Geometry, options: &FaceCollapseOptions) -> Vec<bool> {
     let mut flags = vec![false; mesh.face_capacity()];
     for f in mesh.faces() {
         let s = geometry.vertex_normal_sum(mesh, f);
         let mut flag = geometry.face_normals[f.index()].dot(s) < options.fold_slack;
         if let Some(min) = options.min_normal_size {
-            flag &= s.length() / 3.0 >= min;
+            flag &= s.length() / 3.0 >= min || folds_onto_a_neighbour(mesh, geometry, f);
         }
         flags[f.index()] = flag;
     }
     flags
+}
+
+/// Whether face `f` meets a neighbour at a concave edge bent by more than 90°: the normals
+/// oppose (`n_f·n_g < 0`) and the neighbour's far vertex lies in front of `f`. That is the
+/// surface turning back on itself (a fold). A thin part's knife edge is the convex case: its
+/// two faces oppose too, but each lies behind the other.
+///
+/// ```text
+///   fold (concave):   g ──────┐          knife edge (convex):  f ──────┐
+///                     f ──────┘ n_f ↓ faces g                  g ──────┘ n_f ↑ away from g
+/// ```
+pub fn folds_onto_a_neighbour(mesh: &Mesh, geometry: &Geometry, f: roar_mesh::FaceId) -> bool {
+    let n_f = geometry.face_normals[f.index()];
+    mesh.face_halfedges(f).into_iter().any(|h| {
+        let g = mesh.face(h.twin());
+        let far = mesh.position(mesh.opposite_vertex(h.twin()));
+        n_f.dot(geometry.face_normals[g.index()]) < 0.0
+            && n_f.dot(far - mesh.position(mesh.tail(h))) > 0.0
+    })
 }
 
 /// Runs the Face Collapse block (spec §3.6, note 4) and then the flips; compacts the mesh and

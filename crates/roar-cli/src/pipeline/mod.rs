@@ -391,6 +391,8 @@ pub fn default_blocks(config: &ReconstructConfig) -> Vec<ScheduledBlock> {
             block: Box::new(FaceCollapse {
                 options: FaceCollapseOptions {
                     fold_slack: config.collapse_fold_slack,
+                    min_normal_size: (config.collapse_min_normal_size > 0.0)
+                        .then_some(config.collapse_min_normal_size),
                     ..FaceCollapseOptions::default()
                 },
             }),
