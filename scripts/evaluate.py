@@ -316,6 +316,8 @@ def main():
     parser.add_argument("--timeout", type=int, default=3600, help="seconds per command")
     parser.add_argument("--methods", default=" ".join(METHODS))
     parser.add_argument("--out", required=True)
+    parser.add_argument("--keep-from", action="append", default=[], metavar="DIR",
+                        help="also keep rows of methods not run now from DIR/results.json")
     args = parser.parse_args()
     args.budgets = [int(b) for b in args.budgets.split()]
     args.scripts = os.path.dirname(os.path.abspath(__file__))
@@ -337,7 +339,10 @@ def main():
         "roar": args.roar,
         "meshes": {},
     }
-    kept = earlier_rows(os.path.join(args.out, "results.json"), args, methods)
+    kept = {}
+    for folder in [args.out] + args.keep_from:
+        for name, rows in earlier_rows(os.path.join(folder, "results.json"), args, methods).items():
+            kept.setdefault(name, {}).update(rows)
     log("%d meshes, budgets %s, methods %s" % (len(meshes), args.budgets, " ".join(methods)))
     for mesh in meshes:
         name = os.path.basename(mesh)

@@ -6,6 +6,7 @@
 #
 #   scripts/evaluate.sh [--budgets "1000 5000"] [--meshes "GLOB ..."] [--iterations K] [--out DIR]
 #                       [--samples S] [--timeout SECONDS] [--methods "roar roar-init+qem ..."]
+#                       [--keep-from DIR ...]
 #
 # Inputs: $ROAR_TEST_DATA/wild (default ROAR_TEST_DATA: ../shared/data/meshes beside the repo).
 # The peers (pymeshlab, point-cloud-utils) go into the virtualenv target/eval-venv, made on first
@@ -21,8 +22,9 @@ out="target/evaluation"
 samples=50000
 timeout=3600
 methods="roar roar-init+qem alphawrap+qem manifold+qem"
+keep_from=()
 
-usage() { sed -n '2,12p' "$0" | sed 's/^# \{0,1\}//'; }
+usage() { sed -n '2,13p' "$0" | sed 's/^# \{0,1\}//'; }
 while [ $# -gt 0 ]; do
   case "$1" in
     --budgets) budgets="$2"; shift 2 ;;
@@ -32,6 +34,7 @@ while [ $# -gt 0 ]; do
     --samples) samples="$2"; shift 2 ;;
     --timeout) timeout="$2"; shift 2 ;;
     --methods) methods="$2"; shift 2 ;;
+    --keep-from) keep_from+=(--keep-from "$2"); shift 2 ;;
     -h|--help) usage; exit 0 ;;
     *) echo "evaluate.sh: unknown argument $1" >&2; usage >&2; exit 2 ;;
   esac
@@ -61,6 +64,7 @@ mkdir -p "$out"
 args=(--roar "$roar" --python "$venv/bin/python" --data "$data" --meshes "$meshes"
       --budgets "$budgets" --samples "$samples" --timeout "$timeout" --methods "$methods"
       --out "$out")
+args+=("${keep_from[@]}")
 if [ -n "$iterations" ]; then
   args+=(--iterations "$iterations")
 fi
