@@ -2,7 +2,8 @@
 //! as amended by Verification note 4), followed by the edge flips of §3.7.
 //!
 //! 1. Flag face f when `n_f · (n_v0 + n_v1 + n_v2) < slack` (unit vertex normals, slack 0.6).
-//!    Optional gate (off): skip faces whose `|n_o(f)| = |Σ n_vk| / 3` is below 0.98.
+//!    Optional gate (off here, on in the pipeline): skip faces whose `|n_o(f)| = |Σ n_vk| / 3`
+//!    is below 0.98 (creases, thin parts), unless they fold back onto a neighbour.
 //! 2. Candidate edges: the edges of flagged faces, priority `exp(−|e|)`.
 //! 3. Validity: the QSlim collapse simulation ([`crate::qslim::edge_cost`]); no incident face may
 //!    flip, and optionally (off for fold removal) no resulting face may have `Q > 5`. An edge
@@ -26,7 +27,8 @@ pub struct FaceCollapseOptions {
     /// supplementary's slack added to the code's 0).
     pub fold_slack: f64,
     /// Off-by-default gate: do not collapse flagged faces whose vertex-derived normal
-    /// `|n_o(f)|` is below this ("normal size 0.98", note 4). `None` = off.
+    /// `|n_o(f)|` is below this ("normal size 0.98", note 4), unless they fold back onto a
+    /// neighbour ([`folds_onto_a_neighbour`]). `None` = off.
     pub min_normal_size: Option<f64>,
     /// Collapse validity; default: flip test only, `max_quality: None` (note 4: the Q ≤ 5 check
     /// is off for fold removal).
@@ -77,8 +79,10 @@ pub fn flagged_faces(mesh: &Mesh, geometry: &Geometry, options: &FaceCollapseOpt
 /// two faces oppose too, but each lies behind the other.
 ///
 /// ```text
-///   fold (concave):   g ──────┐          knife edge (convex):  f ──────┐
-///                     f ──────┘ n_f ↓ faces g                  g ──────┘ n_f ↑ away from g
+///   fold (concave): g in front of f        knife edge (convex): g behind f
+///        g ───────┐                                ↑ n_f
+///          ↑ n_f  │                           f ───────┐
+///        f ───────┘                           g ───────┘
 /// ```
 pub fn folds_onto_a_neighbour(mesh: &Mesh, geometry: &Geometry, f: roar_mesh::FaceId) -> bool {
     let n_f = geometry.face_normals[f.index()];
