@@ -35,7 +35,7 @@ pub use projector::{Projector, SphereProjector};
 pub use ray_projector::{RayCastProjector, RayProjectorOptions};
 pub use regular_sampling::{
     RegularSamples, RegularSamplingError, RegularSamplingOptions, SamplePoints, face_grid,
-    grid_point_count, regular_sample_points, regular_samples,
+    grid_point_count, regular_sample_points, regular_sample_points_into, regular_samples,
 };
 pub use sampling::{SurfaceSamples, sample_surface};
 pub use self_intersections::{face_intersects_any, intersecting_pairs, self_intersecting_faces};

@@ -217,7 +217,16 @@ pub fn regular_samples(
     options: &RegularSamplingOptions,
     rng: &mut impl Rng,
 ) -> Result<RegularSamples, RegularSamplingError> {
-    sample_faces(positions, triangles, vertex_normals, options, rng, true)
+    let buffers = (Vec::new(), Vec::new());
+    sample_faces(
+        positions,
+        triangles,
+        vertex_normals,
+        options,
+        rng,
+        buffers,
+        true,
+    )
 }
 
 /// The sample points and normals of every face and each face's grid: the parts of
@@ -248,23 +257,54 @@ pub fn regular_sample_points(
     options: &RegularSamplingOptions,
     rng: &mut impl Rng,
 ) -> Result<SamplePoints, RegularSamplingError> {
-    let s = sample_faces(positions, triangles, vertex_normals, options, rng, false)?;
-    Ok(SamplePoints {
+    let mut out = SamplePoints::default();
+    regular_sample_points_into(&mut out, positions, triangles, vertex_normals, options, rng)?;
+    Ok(out)
+}
+
+/// [`regular_sample_points`] into `out`, reusing the memory of its point and normal buffers
+/// (repeated calls then touch no fresh pages for them). On error `out` is left empty.
+pub fn regular_sample_points_into(
+    out: &mut SamplePoints,
+    positions: &[DVec3],
+    triangles: &[[u32; 3]],
+    vertex_normals: Option<&[DVec3]>,
+    options: &RegularSamplingOptions,
+    rng: &mut impl Rng,
+) -> Result<(), RegularSamplingError> {
+    let buffers = (
+        std::mem::take(&mut out.points),
+        std::mem::take(&mut out.normals),
+    );
+    *out = SamplePoints::default();
+    let s = sample_faces(
+        positions,
+        triangles,
+        vertex_normals,
+        options,
+        rng,
+        buffers,
+        false,
+    )?;
+    *out = SamplePoints {
         points: s.points,
         normals: s.normals,
         face_n: s.face_n,
         face_offsets: s.face_offsets,
-    })
+    };
+    Ok(())
 }
 
-/// [`regular_samples`]; with `full == false` the `faces`, `barycentrics`, `sub_triangles` and
-/// `sub_triangle_faces` of the result are left empty.
+/// [`regular_samples`], writing points and normals into the recycled `buffers`; with
+/// `full == false` the `faces`, `barycentrics`, `sub_triangles` and `sub_triangle_faces` of
+/// the result are left empty.
 fn sample_faces(
     positions: &[DVec3],
     triangles: &[[u32; 3]],
     vertex_normals: Option<&[DVec3]>,
     options: &RegularSamplingOptions,
     rng: &mut impl Rng,
+    buffers: (Vec<DVec3>, Vec<DVec3>),
     full: bool,
 ) -> Result<RegularSamples, RegularSamplingError> {
     check_triangle_indices(positions.len(), triangles)?;
@@ -278,17 +318,24 @@ fn sample_faces(
     }
     let diagonal = referenced_bbox_diagonal(positions, triangles);
 
-    // Grid sizes and offsets first, sequentially: one RNG draw per rounded face, in face order,
-    // so the samples do not depend on the thread count.
+    // Continuous grid sizes in parallel (each depends only on its face), then grid sizes and
+    // offsets sequentially: one RNG draw per rounded face, in face order, so the samples do
+    // not depend on the thread count.
+    let continuous: Vec<f64> = triangles
+        .par_iter()
+        .with_min_len(4096)
+        .map(|tri| {
+            let [p0, p1, p2] = tri.map(|v| positions[v as usize]);
+            let doubled_area = (p1 - p0).cross(p2 - p0).length();
+            continuous_grid_size(doubled_area, diagonal, options.density)
+        })
+        .collect();
     let mut face_n = Vec::with_capacity(triangles.len());
     let mut face_offsets = Vec::with_capacity(triangles.len() + 1);
     let mut face_sub_triangle_offsets = Vec::with_capacity(triangles.len() + 1);
     let mut sample_count = 0usize;
     let mut sub_count = 0usize;
-    for tri in triangles {
-        let [p0, p1, p2] = tri.map(|v| positions[v as usize]);
-        let doubled_area = (p1 - p0).cross(p2 - p0).length();
-        let n_cont = continuous_grid_size(doubled_area, diagonal, options.density);
+    for &n_cont in &continuous {
         let n = round_grid_size(n_cont, options.min_n, options.max_n, rng);
         face_n.push(n);
         face_offsets.push(sample_count as u32);
@@ -306,8 +353,11 @@ fn sample_faces(
         grids[n as usize].get_or_insert_with(|| face_grid(n));
     }
 
-    let mut points = vec![DVec3::ZERO; sample_count];
-    let mut normals = vec![DVec3::ZERO; sample_count];
+    let (mut points, mut normals) = buffers;
+    points.clear();
+    points.resize(sample_count, DVec3::ZERO);
+    normals.clear();
+    normals.resize(sample_count, DVec3::ZERO);
     let (extra_samples, extra_subs) = if full {
         (sample_count, sub_count)
     } else {
@@ -554,6 +604,11 @@ mod tests {
             assert_eq!(light.face_n, full.face_n);
             assert_eq!(light.face_offsets, full.face_offsets);
             assert_eq!(a.random::<u64>(), b.random::<u64>(), "same RNG draws");
+            // Reusing a buffer filled for another mesh gives the same samples.
+            let mut reused = regular_sample_points(&p, &t[..2], None, &options, &mut a).unwrap();
+            let mut c = ChaCha8Rng::seed_from_u64(9);
+            regular_sample_points_into(&mut reused, &p, &t, normals, &options, &mut c).unwrap();
+            assert_eq!(reused, light);
             for f in 0..t.len() {
                 let (_, sub) = face_grid(light.face_n[f]);
                 let shifted: Vec<[u32; 3]> = sub
