@@ -72,10 +72,10 @@ pub struct FaceSplitOptions {
     /// Seed of the sampler's stochastic rounding (the block wrapper mixes in the iteration).
     pub seed: u64,
     /// Compute the QSlim cost (with its validity simulation) only for the edges that can
-    /// change the result, i.e. those with `C_e` below τ, or below the largest face score when
-    /// at or over budget (exact: same collapses and splits; the `independent_edges`, `link`
-    /// and, under budget, `swaps` stats then count only among those edges). `false` computes
-    /// every edge, the reference for tests. Default true.
+    /// change the result: those with `C_e` below τ, and, at or over budget when those do not
+    /// decide the swap count, below the largest face score (exact: same collapses and splits;
+    /// the `independent_edges`, `link` and, under budget, `swaps` stats then count only among
+    /// those edges). `false` computes every edge, the reference for tests. Default true.
     pub prune_edge_costs: bool,
 }
 
@@ -255,7 +255,9 @@ thread_local! {
 /// Stats: `candidates` = faces with a positive score after suppression; `accepted` = face
 /// splits; `rejected`: `"budget"` (scored faces not split), `"link"`, `"sampling"`;
 /// `counters`: `faces_before`, `faces_after`, `independent_edges`, `swaps` (k),
-/// `paired_collapses`, `free_collapses`, `suppressed_edges`.
+/// `paired_collapses`, `free_collapses`, `suppressed_edges`, `edge_costs` (edges whose exact
+/// QSlim cost was computed; see [`FaceSplitOptions::prune_edge_costs`] for what
+/// `independent_edges`, `link` and `swaps` count when it is on).
 pub fn face_split(
     mesh: &mut Mesh,
     optimizer: &mut Optimizer,
