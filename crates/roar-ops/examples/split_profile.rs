@@ -9,16 +9,19 @@
 //! ```
 //!
 //! Arguments: number of repetitions (default 5), then the mode: `all` (default: phase
-//! breakdown and the block), `block` (only `face_split`) or `setup` (only the mesh set-up, to
-//! subtract from the `block` count).
+//! breakdown and the block), `block` (only `face_split`), `setup` (only the mesh set-up, to
+//! subtract from the `block` count) or `digest` (one line per scenario: a hash of the output
+//! mesh, its positions' bits and the optimizer rows, plus the stats; compare two builds' lines
+//! to check that a change keeps the block's results bit-identical).
 
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
-use roar_mesh::shapes::perturbed;
+use roar_mesh::shapes::{genus_n_solid, icosphere, perturbed};
 use roar_mesh::spatial::{Projector, SphereProjector, regular_samples};
 use roar_mesh::{DVec3, Mesh};
 use roar_ops::geometry::Geometry;
 use roar_ops::optim::{Optimizer, OptimizerOptions};
+use roar_ops::qslim::{QSlimOptions, VertexPlane};
 use roar_ops::split_block::{FaceSplitOptions, SplitThreshold, face_scores, face_split};
 use std::time::Instant;
 
@@ -59,6 +62,110 @@ fn uv_sphere(lat: usize, lon: usize) -> Mesh {
     Mesh::from_triangles(positions, &tris).expect("uv sphere is a closed manifold")
 }
 
+/// FNV-1a over the mesh's triangles, its positions' bits and the optimizer rows' `m1`.
+fn digest(mesh: &Mesh, optimizer: &Optimizer) -> u64 {
+    let mut h = 0xcbf2_9ce4_8422_2325u64;
+    let mut eat = |x: u64| {
+        for byte in x.to_le_bytes() {
+            h = (h ^ u64::from(byte)).wrapping_mul(0x0100_0000_01b3);
+        }
+    };
+    for f in mesh.faces() {
+        for v in mesh.face_vertices(f) {
+            eat(u64::from(v.raw()));
+        }
+    }
+    for p in mesh.positions() {
+        for c in p.to_array() {
+            eat(c.to_bits());
+        }
+    }
+    for row in optimizer.state() {
+        for c in row.m1.to_array() {
+            eat(c.to_bits());
+        }
+    }
+    h
+}
+
+/// Runs `calls` Face Split calls per scenario (seed = call index) and prints a digest line each.
+fn digests(calls: u64) {
+    let sphere = SphereProjector {
+        center: DVec3::ZERO,
+        radius: 1.0,
+    };
+    let offset = SphereProjector {
+        center: DVec3::new(0.05, -0.02, 0.03),
+        radius: 1.02,
+    };
+    let per_face = FaceSplitOptions {
+        threshold: SplitThreshold::PerFace(0.02),
+        ..FaceSplitOptions::default()
+    };
+    let normalized = FaceSplitOptions {
+        qslim: QSlimOptions {
+            vertex_plane: VertexPlane::NormalizedMagnitude,
+            ..QSlimOptions::default()
+        },
+        ..per_face
+    };
+    let bench = perturbed(&uv_sphere(50, 100), 0.002, 2);
+    let rough = perturbed(&uv_sphere(50, 100), 0.02, 1);
+    let coarse = icosphere(1);
+    let slab = genus_n_solid(2);
+    let f = |m: &Mesh| m.n_faces() as i64;
+    let scenarios: Vec<(&str, &Mesh, &SphereProjector, i64, FaceSplitOptions)> = vec![
+        ("bench_under", &bench, &sphere, 2000, per_face),
+        ("bench_at", &bench, &sphere, 0, per_face),
+        ("bench_over", &bench, &sphere, -400, per_face),
+        (
+            "bench_default_at",
+            &bench,
+            &sphere,
+            0,
+            FaceSplitOptions::default(),
+        ),
+        ("rough_under", &rough, &offset, 2000, per_face),
+        ("rough_at", &rough, &offset, 0, per_face),
+        (
+            "rough_default_at",
+            &rough,
+            &offset,
+            0,
+            FaceSplitOptions::default(),
+        ),
+        ("coarse_under", &coarse, &offset, 60, per_face),
+        ("coarse_at", &coarse, &offset, 0, per_face),
+        ("coarse_over", &coarse, &sphere, -20, per_face),
+        ("coarse_normalized_at", &coarse, &sphere, 0, normalized),
+        ("slab_over", &slab, &sphere, -40, normalized),
+        ("slab_at", &slab, &offset, 0, per_face),
+    ];
+    for (name, mesh, projector, slack, options) in scenarios {
+        let mut m = mesh.clone();
+        let mut o =
+            Optimizer::new(m.vertex_capacity(), OptimizerOptions::default()).expect("optimizer");
+        // Tag each row with its vertex position, so the digest sees which rows survive.
+        for v in m.vertices() {
+            o.state_mut()[v.index()].m1 = m.position(v);
+        }
+        let budget = (f(mesh) + slack) as usize;
+        let mut line = String::new();
+        for seed in 0..calls {
+            let options = FaceSplitOptions { seed, ..options };
+            let stats = face_split(&mut m, &mut o, projector, budget, &options);
+            line += &format!(
+                " [{} faces, {} splits, {} paired, {} free]",
+                m.n_faces(),
+                stats.accepted,
+                stats.counters.get("paired_collapses").copied().unwrap_or(0),
+                stats.counters.get("free_collapses").copied().unwrap_or(0),
+            );
+        }
+        println!("{name}: {:016x}{line}", digest(&m, &o));
+    }
+}
+
 fn ms(t: Instant) -> f64 {
     t.elapsed().as_secs_f64() * 1e3
 }
@@ -79,6 +186,10 @@ fn main() {
         ..FaceSplitOptions::default()
     };
     let f = mesh.n_faces();
+    if mode == "digest" {
+        digests(reps as u64);
+        return;
+    }
     for _ in 0..reps {
         if mode == "setup" {
             continue;
@@ -89,7 +200,12 @@ fn main() {
                 .expect("optimizer");
             let t = Instant::now();
             let stats = face_split(&mut m, &mut o, &sphere, f + 2000, &options);
-            println!("face_split {:.1} ms, accepted {}", ms(t), stats.accepted);
+            println!(
+                "face_split {:.1} ms, accepted {}, exact edge costs {}",
+                ms(t),
+                stats.accepted,
+                stats.counters.get("edge_costs").copied().unwrap_or(0)
+            );
             continue;
         }
         // Phase breakdown (the block recomputes these itself).

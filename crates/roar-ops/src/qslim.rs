@@ -268,6 +268,20 @@ pub fn edge_cost(
     best.ok_or(failure.unwrap_or(Invalid::Flip))
 }
 
+/// A lower bound of the QSlim cost of edge `e`: the smaller clamped quadric value of its two
+/// endpoint placements, without the validity simulation. It is computed with the same
+/// arithmetic as [`edge_cost`], whose cost (when `Ok`) is one of these two values, so
+/// `edge_cost(mesh, quadrics, e, options)?.cost >= edge_cost_lower_bound(mesh, quadrics, e)`
+/// holds exactly, for every `options`.
+pub fn edge_cost_lower_bound(mesh: &Mesh, quadrics: &[Quadric], e: EdgeId) -> f64 {
+    let h = e.halfedge();
+    let (a, b) = (mesh.tail(h), mesh.head(h));
+    let q = quadrics[a.index()].sum(&quadrics[b.index()]);
+    let keep_b = q.eval(mesh.position(b)).max(0.0);
+    let keep_a = q.eval(mesh.position(a)).max(0.0);
+    keep_b.min(keep_a)
+}
+
 /// Simulates moving `remove` onto `keep`'s position (they share an edge) and checks the faces
 /// around `remove` that survive the collapse.
 fn placement_valid(
@@ -324,6 +338,32 @@ mod tests {
         let d = n.dot(p - x0);
         assert!((q.eval(p) - 2.0 * d * d).abs() < 1e-12);
         assert!(q.eval(x0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn lower_bound_never_exceeds_the_cost() {
+        let mesh = roar_mesh::shapes::perturbed(&roar_mesh::shapes::icosphere(3), 0.01, 4);
+        let g = Geometry::compute(&mesh);
+        let q = vertex_quadrics(&mesh, &g, &QSlimOptions::default());
+        let strict = ValidityOptions {
+            max_quality: Some(5.0),
+            ..ValidityOptions::default()
+        };
+        let (mut valid, mut tight) = (0, 0);
+        for e in mesh.edges() {
+            let lower = edge_cost_lower_bound(&mesh, &q, e);
+            for options in [ValidityOptions::default(), strict] {
+                if let Ok(c) = edge_cost(&mesh, &q, e, &options) {
+                    assert!(c.cost >= lower, "{e:?}: {} < {lower}", c.cost);
+                    valid += 1;
+                    tight += usize::from(c.cost == lower);
+                }
+            }
+        }
+        assert!(
+            valid > 1000 && tight > valid / 2,
+            "{valid} valid, {tight} tight"
+        );
     }
 
     #[test]

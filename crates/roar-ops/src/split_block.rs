@@ -18,13 +18,20 @@
 use crate::block::{Block, BlockContext, BlockStats, compact_with_optimizer, sync_optimizer_len};
 use crate::geometry::Geometry;
 use crate::optim::Optimizer;
-use crate::qslim::{EdgeCost, QSlimOptions, ValidityOptions, edge_cost, vertex_quadrics};
-use crate::select::{SelectOptions, select_independent_edges};
+use crate::qslim::{
+    EdgeCost, QSlimOptions, Quadric, ValidityOptions, edge_cost, edge_cost_lower_bound,
+    vertex_quadrics,
+};
+use crate::select::{SelectOptions, Selection, select_independent_edges};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
-use roar_mesh::spatial::{Projector, RegularSamples, RegularSamplingOptions, regular_samples};
+use roar_mesh::spatial::{
+    Projector, RegularSamples, RegularSamplingOptions, SamplePoints, face_grid, grid_point_count,
+    regular_sample_points_into,
+};
 use roar_mesh::{DEGENERATE_CROSS, DVec3, EdgeId, FaceId, Mesh};
+use std::cell::RefCell;
 
 /// Where the 0.02 curvature threshold of the face score applies (Verification note 1).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -64,6 +71,12 @@ pub struct FaceSplitOptions {
     pub select: SelectOptions,
     /// Seed of the sampler's stochastic rounding (the block wrapper mixes in the iteration).
     pub seed: u64,
+    /// Compute the QSlim cost (with its validity simulation) only for the edges that can
+    /// change the result: those with `C_e` below τ, and, at or over budget when those do not
+    /// decide the swap count, below the largest face score (exact: same collapses and splits;
+    /// the `independent_edges`, `link` and, under budget, `swaps` stats then count only among
+    /// those edges). `false` computes every edge, the reference for tests. Default true.
+    pub prune_edge_costs: bool,
 }
 
 impl Default for FaceSplitOptions {
@@ -81,6 +94,7 @@ impl Default for FaceSplitOptions {
             qslim: QSlimOptions::default(),
             select: SelectOptions::default(),
             seed: 0,
+            prune_edge_costs: true,
         }
     }
 }
@@ -95,17 +109,39 @@ pub fn face_scores(
     projected: &[Option<DVec3>],
     options: &FaceSplitOptions,
 ) -> Vec<f64> {
+    grid_scores(
+        mesh,
+        geometry,
+        &samples.face_n,
+        &samples.face_offsets,
+        projected,
+        options,
+    )
+}
+
+/// [`face_scores`] from each face's grid size `face_n[f]` and first sample `face_offsets[f]`;
+/// its sub-triangles are those of [`face_grid`], as in [`RegularSamples::sub_triangles`].
+fn grid_scores(
+    mesh: &Mesh,
+    geometry: &Geometry,
+    face_n: &[u32],
+    face_offsets: &[u32],
+    projected: &[Option<DVec3>],
+    options: &FaceSplitOptions,
+) -> Vec<f64> {
     let folds = geometry.face_folds(mesh);
     let (sub_threshold, face_threshold) = match options.threshold {
         SplitThreshold::PerSubTriangle(t) => (t, 0.0),
         SplitThreshold::PerFace(t) => (0.0, t),
     };
+    let max_n = face_n.iter().copied().max().unwrap_or(0);
+    let grids: Vec<Vec<[u32; 3]>> = (0..=max_n).map(|n| face_grid(n).1).collect();
     (0..mesh.face_capacity())
         .into_par_iter()
         .with_min_len(256)
         .map_init(
             || (Vec::new(), Vec::new()),
-            |(normals, subs): &mut (Vec<DVec3>, Vec<Option<DVec3>>), f| {
+            |(normals, subs): &mut (Vec<DVec3>, Vec<DVec3>), f| {
                 let face = FaceId::from_index(f);
                 if !mesh.is_face_alive(face) || folds[f] > 1.0 {
                     return 0.0;
@@ -117,10 +153,12 @@ pub fn face_scores(
                 {
                     return 0.0;
                 }
+                let n = face_n[f] as usize;
                 let s = grid_score(
-                    samples,
                     projected,
-                    f,
+                    face_offsets[f] as usize,
+                    grid_point_count(n as u32),
+                    &grids[n],
                     geometry.face_normals[f],
                     sub_threshold,
                     normals,
@@ -136,7 +174,8 @@ pub fn face_scores(
         .collect()
 }
 
-/// `Σ_t fold(t)` over face `f`'s projected grid (§3.5 steps 1–4). `normals`/`subs` are scratch.
+/// `Σ_t fold(t)` over one face's projected grid (§3.5 steps 1–4): its `count` samples start at
+/// `start` in `projected` and `sub_triangles` index them from 0. `normals`/`subs` are scratch.
 /// [INF: a projected sub-triangle with `|cross| ≤ 1e-9` counts as invalid.]
 ///
 /// The ROAR vertex normal weight `area · angle · n_t` is accumulated as `angle · cross_t`
@@ -144,56 +183,54 @@ pub fn face_scores(
 /// normal of each sub-triangle is normalized; two corner angles come from `acos` of the edge
 /// cosines and the third is `π` minus them (glibc's `acos` costs about half its `atan2`;
 /// sub-triangles thin enough for `acos` to lose accuracy are rare and only change a weight).
+#[allow(clippy::too_many_arguments)]
 fn grid_score(
-    samples: &RegularSamples,
     projected: &[Option<DVec3>],
-    f: usize,
+    start: usize,
+    count: usize,
+    sub_triangles: &[[u32; 3]],
     face_normal: DVec3,
     sub_threshold: f64,
     normals: &mut Vec<DVec3>,
-    subs: &mut Vec<Option<DVec3>>,
+    subs: &mut Vec<DVec3>,
 ) -> f64 {
-    let points = samples.face_samples(f);
-    let start = points.start;
     normals.clear();
-    normals.resize(points.len(), DVec3::ZERO);
+    normals.resize(count, DVec3::ZERO);
+    // Unit normal of each valid projected sub-triangle, zero for invalid ones.
     subs.clear();
-    let sub_range = samples.face_sub_triangles(f);
-    let sub_triangles = &samples.sub_triangles[sub_range];
     for idx in sub_triangles {
-        let corner = |k: usize| projected.get(idx[k] as usize).copied().flatten();
+        let corner = |k: usize| projected.get(start + idx[k] as usize).copied().flatten();
         let (Some(q0), Some(q1), Some(q2)) = (corner(0), corner(1), corner(2)) else {
-            subs.push(None);
+            subs.push(DVec3::ZERO);
             continue;
         };
         let (e01, e02, e12) = (q1 - q0, q2 - q0, q2 - q1);
         let cross = e01.cross(e02);
         let len = cross.length();
         if len.is_nan() || len <= DEGENERATE_CROSS || !len.is_finite() {
-            subs.push(None);
+            subs.push(DVec3::ZERO);
             continue;
         }
         let (l01, l02, l12) = (e01.length(), e02.length(), e12.length());
         let a0 = (e01.dot(e02) / (l01 * l02)).clamp(-1.0, 1.0).acos();
         let a1 = (-e01.dot(e12) / (l01 * l12)).clamp(-1.0, 1.0).acos();
         let a2 = (std::f64::consts::PI - a0 - a1).max(0.0);
-        normals[idx[0] as usize - start] += a0 * cross;
-        normals[idx[1] as usize - start] += a1 * cross;
-        normals[idx[2] as usize - start] += a2 * cross;
-        subs.push(Some(cross / len));
+        normals[idx[0] as usize] += a0 * cross;
+        normals[idx[1] as usize] += a1 * cross;
+        normals[idx[2] as usize] += a2 * cross;
+        subs.push(cross / len);
     }
     for n in normals.iter_mut() {
         *n = n.normalize_or_zero();
     }
     let mut score = 0.0;
-    for (idx, n) in sub_triangles.iter().zip(subs.iter()) {
-        let Some(n) = *n else { continue };
-        if n.dot(face_normal) < 0.0 {
+    for (idx, &n) in sub_triangles.iter().zip(subs.iter()) {
+        if n == DVec3::ZERO || n.dot(face_normal) < 0.0 {
             continue;
         }
-        let sum = n.dot(normals[idx[0] as usize - start])
-            + n.dot(normals[idx[1] as usize - start])
-            + n.dot(normals[idx[2] as usize - start]);
+        let sum = n.dot(normals[idx[0] as usize])
+            + n.dot(normals[idx[1] as usize])
+            + n.dot(normals[idx[2] as usize]);
         let fold = 1.0 - sum / 3.0;
         if fold > 1.0 || fold < sub_threshold {
             continue;
@@ -203,13 +240,24 @@ fn grid_score(
     score
 }
 
+thread_local! {
+    /// The sample points and normals of the last [`face_split`] call on this thread, kept so
+    /// the next call reuses their memory (about 13 MB for a 10k-face mesh at the default
+    /// density): allocated afresh, the allocator handed them back to the system between calls
+    /// and every call paid some 3 000 page faults (several ms) to touch them again.
+    static SAMPLE_BUFFERS: RefCell<SamplePoints> = RefCell::new(SamplePoints::default());
+}
+
 /// Runs the Face Split block (spec §3.8) with face budget `face_budget` and target projector
-/// `projector`; compacts the mesh and optimizer rows if the topology changed.
+/// `projector`; compacts the mesh and optimizer rows if the topology changed. Keeps its sample
+/// buffers per thread between calls (see `SAMPLE_BUFFERS`).
 ///
 /// Stats: `candidates` = faces with a positive score after suppression; `accepted` = face
 /// splits; `rejected`: `"budget"` (scored faces not split), `"link"`, `"sampling"`;
 /// `counters`: `faces_before`, `faces_after`, `independent_edges`, `swaps` (k),
-/// `paired_collapses`, `free_collapses`, `suppressed_edges`.
+/// `paired_collapses`, `free_collapses`, `suppressed_edges`, `edge_costs` (edges whose exact
+/// QSlim cost was computed; see [`FaceSplitOptions::prune_edge_costs`] for what
+/// `independent_edges`, `link` and `swaps` count when it is on).
 pub fn face_split(
     mesh: &mut Mesh,
     optimizer: &mut Optimizer,
@@ -234,29 +282,42 @@ pub fn face_split(
         .faces()
         .map(|f| mesh.face_vertices(f).map(|v| v.raw()))
         .collect();
-    let mut rng = ChaCha8Rng::seed_from_u64(options.seed);
-    let samples = match regular_samples(
-        mesh.positions(),
-        &triangles,
-        Some(&geometry.vertex_normals),
-        &options.sampling,
-        &mut rng,
-    ) {
-        Ok(s) => s,
-        Err(_) => {
-            stats.reject("sampling", 1);
-            return stats;
-        }
+    let score_faces = |samples: &mut SamplePoints| -> Option<Vec<f64>> {
+        let mut rng = ChaCha8Rng::seed_from_u64(options.seed);
+        regular_sample_points_into(
+            samples,
+            mesh.positions(),
+            &triangles,
+            Some(&geometry.vertex_normals),
+            &options.sampling,
+            &mut rng,
+        )
+        .ok()?;
+        let projected = projector.project(
+            mesh.positions(),
+            &triangles,
+            &samples.points,
+            &samples.normals,
+        );
+        Some(grid_scores(
+            mesh,
+            &geometry,
+            &samples.face_n,
+            &samples.face_offsets,
+            &projected,
+            options,
+        ))
     };
-    let projected = projector.project(
-        mesh.positions(),
-        &triangles,
-        &samples.points,
-        &samples.normals,
-    );
-    let mut scores = face_scores(mesh, &geometry, &samples, &projected, options);
+    let scores = SAMPLE_BUFFERS.with(|buffers| match buffers.try_borrow_mut() {
+        Ok(mut samples) => score_faces(&mut samples),
+        Err(_) => score_faces(&mut SamplePoints::default()), // re-entered from the projector
+    });
+    let Some(mut scores) = scores else {
+        stats.reject("sampling", 1);
+        return stats;
+    };
 
-    // 2. Edge costs C_e = P_e + QS_e.
+    // 2. Edge costs C_e = P_e + QS_e, computed where they can matter (see `EdgeCosts`).
     let mut vertex_max = vec![0.0f64; mesh.vertex_capacity()];
     for f in mesh.faces() {
         for v in mesh.face_vertices(f) {
@@ -264,24 +325,21 @@ pub fn face_split(
         }
     }
     let quadrics = vertex_quadrics(mesh, &geometry, &options.qslim);
-    let edges: Vec<EdgeId> = mesh.edges().collect();
-    let costs: Vec<(f64, f64, Option<EdgeCost>)> = edges
-        .par_iter()
-        .with_min_len(512)
-        .map(|&e| {
-            let [a, b] = mesh.edge_vertices(e);
-            let potential = vertex_max[a.index()].max(vertex_max[b.index()]);
-            match edge_cost(mesh, &quadrics, e, &options.validity) {
-                Ok(c) => (potential + c.cost, potential, Some(c)),
-                Err(_) => (f64::INFINITY, potential, None),
-            }
-        })
-        .collect();
+    let mut costs = EdgeCosts::new(mesh, &quadrics, &vertex_max);
+    let tau = options.edge_cost_threshold;
+    // Pruning is exact only if an edge kept by the selection cannot exclude a better-ranked
+    // one (the exclusion radius does not exceed the propagation radius), see `EdgeCosts`.
+    let prune = options.prune_edge_costs
+        && options.select.exclusion_rings.max(1) - 1 <= options.select.propagation
+        && tau >= 0.0;
+    let first_threshold = if prune { tau } else { f64::INFINITY };
+    costs.compute_below(mesh, &quadrics, &options.validity, first_threshold);
 
-    // 3. Suppression of flat, redundant neighbourhoods.
+    // 3. Suppression of flat, redundant neighbourhoods: every edge with C_e < τ has its exact
+    //    cost by now.
     let mut suppressed = 0;
-    for (&e, &(cost, _, _)) in edges.iter().zip(&costs) {
-        if cost < options.edge_cost_threshold {
+    for e in mesh.edges() {
+        if costs.cost(e).is_some_and(|c| c < tau) {
             suppressed += 1;
             let h = e.halfedge();
             scores[mesh.face(h).index()] = 0.0;
@@ -290,26 +348,7 @@ pub fn face_split(
     }
     stats.count("suppressed_edges", suppressed);
 
-    // 4. Independent edge set by exp(−C_e); 5. c_e = max(C_e, P_e).
-    let mut priority = vec![0.0; mesh.edge_capacity()];
-    for (&e, &(cost, _, _)) in edges.iter().zip(&costs) {
-        priority[e.index()] = (-cost).exp();
-    }
-    let selection = select_independent_edges(mesh, &priority, &options.select);
-    stats.reject("link", selection.link_rejected);
-    stats.count("independent_edges", selection.edges.len());
-    // Edge ids are dense (compact mesh), so `costs[e]` is edge e's entry.
-    let mut chosen: Vec<(f64, EdgeId)> = selection
-        .edges
-        .iter()
-        .map(|&e| {
-            let (cost, potential, _) = costs[e.index()];
-            (cost.max(potential), e)
-        })
-        .collect();
-    chosen.sort_by(|x, y| x.0.total_cmp(&y.0).then(x.1.cmp(&y.1)));
-
-    // 6. Pairing: faces by S descending, edges by c ascending.
+    // Faces by S descending (§3.8 step 6).
     let mut ranked: Vec<FaceId> = mesh.faces().filter(|f| scores[f.index()] > 0.0).collect();
     ranked.sort_by(|x, y| {
         scores[y.index()]
@@ -317,15 +356,32 @@ pub fn face_split(
             .then(x.cmp(y))
     });
     stats.candidates = ranked.len();
-    let swaps = ranked
-        .iter()
-        .zip(&chosen)
-        .take_while(|(f, (c, _))| scores[f.index()] > *c)
-        .count();
+    let delta = (face_budget as i64 - n_faces as i64).div_euclid(2);
+
+    // 4.–6. Independent set, c_e, pairing. Under budget only the free collapses (c_e < τ)
+    // act, so threshold τ suffices; at or over budget the swaps must be decided too, which
+    // may need a second pass with threshold max S (every edge that can pair with a face).
+    let s_max = ranked.first().map_or(0.0, |f| scores[f.index()]);
+    let mut threshold = first_threshold;
+    let (selection, chosen, swaps) = loop {
+        let (selection, chosen, swaps, decided) =
+            pair_edges(mesh, &costs, &options.select, threshold, &ranked, &scores);
+        if decided || delta > 1 || threshold == f64::INFINITY {
+            break (selection, chosen, swaps);
+        }
+        threshold = if threshold < s_max.max(tau) {
+            s_max.max(tau)
+        } else {
+            f64::INFINITY
+        };
+        costs.compute_below(mesh, &quadrics, &options.validity, threshold);
+    };
+    stats.count("edge_costs", costs.computed);
+    stats.reject("link", selection.link_rejected);
+    stats.count("independent_edges", selection.edges.len());
     stats.count("swaps", swaps);
 
     // 7. Budget logic.
-    let delta = (face_budget as i64 - n_faces as i64).div_euclid(2);
     let (n_paired, n_split) = if delta > 1 {
         (0, ranked.len().min(delta as usize))
     } else {
@@ -345,8 +401,8 @@ pub fn face_split(
     // 8. Apply: collapses, then centroid splits.
     let mut collapsed = 0;
     for e in to_collapse {
-        let c = costs[e.index()]
-            .2
+        let c = costs
+            .placement(e)
             .expect("selected edges have finite cost, so a placement");
         match mesh.collapse(c.halfedge) {
             Ok(out) => {
@@ -376,6 +432,162 @@ pub fn face_split(
     }
     stats.count("faces_after", mesh.n_faces());
     stats
+}
+
+/// Relative margin between the priorities of edges that can matter and those that cannot
+/// (see [`EdgeCosts`]); far larger than the rounding error of `exp`, far smaller than any
+/// meaningful cost difference.
+const PRIORITY_MARGIN: f64 = 1e-9;
+
+/// Priority floor of threshold `t`: `exp(−(t + 1e-9))`. Every edge with `C_e < t` has priority
+/// `exp(−C_e)` above it (by a relative margin of about 1e-9); 0 for `t = ∞`.
+fn priority_floor(t: f64) -> f64 {
+    (-(t + PRIORITY_MARGIN)).exp()
+}
+
+/// QSlim edge costs `C_e = P_e + QS_e` of the Face Split block (spec §3.8 step 2), computed
+/// only where they can change the block's result.
+///
+/// Only edges with `c_e = C_e < t` can act: `t = τ` for suppression and free collapses,
+/// `t = max S` for swaps (a face f pairs with e only if `S_f > c_e`). The independent
+/// selection (§3.11) of those edges depends only on edges ranked above them (a kept edge
+/// excludes edges within `exclusion_rings − 1` hops, inside the `propagation` hops over which
+/// it was a local maximum, so it never excludes a better-ranked one). Hence an edge whose
+/// cheap lower bound `P_e + min(placement values)` ([`edge_cost_lower_bound`]) proves
+/// `C_e ≥ t` and `exp(−C_e) < priority_floor(t)` can be left out: its validity simulation,
+/// the expensive part of [`edge_cost`], is skipped, and the selection runs on the edges with
+/// priority `≥ priority_floor(t)`, which rank above every left-out edge.
+struct EdgeCosts {
+    /// `P_e` by edge id.
+    potential: Vec<f64>,
+    /// `P_e + edge_cost_lower_bound(e) ≤ C_e` by edge id.
+    lower: Vec<f64>,
+    /// `(C_e, placement)` where computed (`C_e = ∞`, no placement, if no placement is valid).
+    exact: Vec<Option<(f64, Option<EdgeCost>)>>,
+    /// Number of edges whose exact cost was computed.
+    computed: usize,
+}
+
+impl EdgeCosts {
+    /// Potentials and lower bounds of every edge (in parallel); no exact cost yet.
+    /// `vertex_max[v]` is the largest score of a face around v.
+    fn new(mesh: &Mesh, quadrics: &[Quadric], vertex_max: &[f64]) -> Self {
+        let ne = mesh.edge_capacity();
+        let (potential, lower): (Vec<f64>, Vec<f64>) = (0..ne)
+            .into_par_iter()
+            .with_min_len(2048)
+            .map(|i| {
+                let e = EdgeId::from_index(i);
+                if !mesh.is_edge_alive(e) {
+                    return (0.0, f64::INFINITY);
+                }
+                let [a, b] = mesh.edge_vertices(e);
+                let p = vertex_max[a.index()].max(vertex_max[b.index()]);
+                (p, p + edge_cost_lower_bound(mesh, quadrics, e))
+            })
+            .unzip();
+        Self {
+            potential,
+            lower,
+            exact: vec![None; ne],
+            computed: 0,
+        }
+    }
+
+    /// Computes `C_e` for every edge not yet computed unless its lower bound proves
+    /// `C_e ≥ t` and `exp(−C_e) < priority_floor(t)` (so `t = ∞` computes every edge). In
+    /// parallel over the edges; the result does not depend on the thread count.
+    fn compute_below(
+        &mut self,
+        mesh: &Mesh,
+        quadrics: &[Quadric],
+        validity: &ValidityOptions,
+        t: f64,
+    ) {
+        let floor = priority_floor(t) * (1.0 - PRIORITY_MARGIN);
+        let todo: Vec<EdgeId> = mesh
+            .edges()
+            .filter(|e| {
+                let lower = self.lower[e.index()];
+                self.exact[e.index()].is_none() && !(lower >= t && (-lower).exp() < floor)
+            })
+            .collect();
+        let potential = &self.potential;
+        let results: Vec<(f64, Option<EdgeCost>)> = todo
+            .par_iter()
+            .with_min_len(512)
+            .map(|&e| {
+                let p = potential[e.index()];
+                match edge_cost(mesh, quadrics, e, validity) {
+                    Ok(c) => (p + c.cost, Some(c)),
+                    Err(_) => (f64::INFINITY, None),
+                }
+            })
+            .collect();
+        self.computed += todo.len();
+        for (e, r) in todo.into_iter().zip(results) {
+            self.exact[e.index()] = Some(r);
+        }
+    }
+
+    /// `C_e` if computed.
+    fn cost(&self, e: EdgeId) -> Option<f64> {
+        self.exact[e.index()].map(|(c, _)| c)
+    }
+
+    /// The best valid placement of `e`, if computed and one exists.
+    fn placement(&self, e: EdgeId) -> Option<EdgeCost> {
+        self.exact[e.index()].and_then(|(_, p)| p)
+    }
+}
+
+/// Kept edges as `(c_e, e)` sorted by `c_e`, then id.
+type Chosen = Vec<(f64, EdgeId)>;
+
+/// §3.8 steps 4–6 on the edges that can matter below threshold `t` (see [`EdgeCosts`]):
+/// the independent set over the edges with priority `exp(−C_e) ≥ priority_floor(t)`, its
+/// edges with `c_e = max(C_e, P_e) < t` sorted by `(c_e, id)`, and the swap count k of the
+/// pairing with `ranked` (faces by S descending). These agree with the unrestricted
+/// computation (`t = ∞`) on every edge with `c_e < t`. The last value says whether k is also
+/// the unrestricted swap count: yes unless all the returned edges swap and the next face
+/// scores above `t` (it might pair with an edge that was left out).
+fn pair_edges(
+    mesh: &Mesh,
+    costs: &EdgeCosts,
+    select: &SelectOptions,
+    t: f64,
+    ranked: &[FaceId],
+    scores: &[f64],
+) -> (Selection, Chosen, usize, bool) {
+    let floor = priority_floor(t);
+    let mut priority = vec![0.0; mesh.edge_capacity()];
+    for e in mesh.edges() {
+        if let Some(c) = costs.cost(e) {
+            let p = (-c).exp();
+            if p >= floor {
+                priority[e.index()] = p;
+            }
+        }
+    }
+    let selection = select_independent_edges(mesh, &priority, select);
+    let mut chosen: Chosen = selection
+        .edges
+        .iter()
+        .filter_map(|&e| {
+            let c = costs.cost(e)?.max(costs.potential[e.index()]);
+            (c < t).then_some((c, e))
+        })
+        .collect();
+    chosen.sort_by(|x, y| x.0.total_cmp(&y.0).then(x.1.cmp(&y.1)));
+    let swaps = ranked
+        .iter()
+        .zip(&chosen)
+        .take_while(|(f, (c, _))| scores[f.index()] > *c)
+        .count();
+    let m = chosen.len();
+    let decided =
+        t == f64::INFINITY || swaps < m || ranked.len() <= m || scores[ranked[m].index()] <= t;
+    (selection, chosen, swaps, decided)
 }
 
 /// [`Block`] wrapper of [`face_split`]: takes the budget and projector from the context and
@@ -420,6 +632,7 @@ mod tests {
     use crate::geometry::corner_angles;
     use rand::Rng;
     use roar_mesh::shapes::icosphere;
+    use roar_mesh::spatial::regular_samples;
 
     /// The direct reading of §3.5 steps 1–4 (unit normals, `acos` corner angles), the brute-force
     /// reference of [`grid_score`].
@@ -505,10 +718,13 @@ mod tests {
         let mut nonzero = 0;
         for f in 0..mesh.n_faces() {
             for threshold in [0.0, 0.02] {
+                let range = samples.face_samples(f);
+                let (_, local) = face_grid(samples.face_n[f]);
                 let fast = grid_score(
-                    &samples,
                     &projected,
-                    f,
+                    range.start,
+                    range.len(),
+                    &local,
                     g.face_normals[f],
                     threshold,
                     &mut normals,

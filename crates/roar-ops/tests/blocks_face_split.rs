@@ -320,3 +320,110 @@ fn default_threshold_sees_creases_from_about_35_degrees_and_the_per_face_rule_ge
     assert!(rates[2].0 < 0.8, "16° creases are partly missed: {rates:?}");
     assert!(rates.iter().all(|r| r.1 >= r.0 && r.1 > 0.95), "{rates:?}");
 }
+
+/// Runs `calls` Face Split calls (seed = call index) on a copy of `mesh` and returns the final
+/// mesh, optimizer and per-call stats.
+fn run_calls(
+    mesh: &roar_mesh::Mesh,
+    projector: &dyn Projector,
+    budget: usize,
+    options: &FaceSplitOptions,
+    calls: u64,
+) -> (
+    roar_mesh::Mesh,
+    roar_ops::optim::Optimizer,
+    Vec<roar_ops::block::BlockStats>,
+) {
+    let mut m = mesh.clone();
+    let mut opt = tagged_optimizer(&m);
+    let stats = (0..calls)
+        .map(|seed| {
+            let options = FaceSplitOptions { seed, ..*options };
+            face_split(&mut m, &mut opt, projector, budget, &options)
+        })
+        .collect();
+    (m, opt, stats)
+}
+
+#[test]
+fn pruned_edge_costs_give_the_same_collapses_and_splits_as_computing_every_edge() {
+    // A fine sphere over its own target (few edges below τ, few scored faces: the first pass
+    // decides), the same sphere roughened against an offset target (many swaps at budget:
+    // needs the second pass) and the slab, under, at and over budget.
+    let fine = roar_mesh::shapes::perturbed(&icosphere(4), 0.002, 2);
+    let rough = roar_mesh::shapes::perturbed(&icosphere(4), 0.01, 1);
+    let offset = SphereProjector {
+        center: DVec3::new(0.05, -0.02, 0.03),
+        radius: 1.02,
+    };
+    let slab = genus_n_solid(2);
+    let normalized = FaceSplitOptions {
+        qslim: QSlimOptions {
+            vertex_plane: VertexPlane::NormalizedMagnitude,
+            ..QSlimOptions::default()
+        },
+        ..per_face()
+    };
+    let cases: Vec<(
+        &str,
+        &roar_mesh::Mesh,
+        &SphereProjector,
+        i64,
+        FaceSplitOptions,
+    )> = vec![
+        ("fine under", &fine, &UNIT_SPHERE, 600, per_face()),
+        ("fine at", &fine, &UNIT_SPHERE, 0, per_face()),
+        ("fine over", &fine, &UNIT_SPHERE, -200, per_face()),
+        (
+            "fine default at",
+            &fine,
+            &UNIT_SPHERE,
+            0,
+            FaceSplitOptions::default(),
+        ),
+        ("rough under", &rough, &offset, 600, per_face()),
+        ("rough at", &rough, &offset, 0, per_face()),
+        ("rough over", &rough, &offset, -200, normalized),
+        ("slab over", &slab, &UNIT_SPHERE, -40, normalized),
+        ("slab at", &slab, &offset, 0, per_face()),
+    ];
+    let mut pruned_somewhere = false;
+    let mut paired = 0;
+    for (name, mesh, projector, slack, options) in cases {
+        let budget = (mesh.n_faces() as i64 + slack) as usize;
+        let full = FaceSplitOptions {
+            prune_edge_costs: false,
+            ..options
+        };
+        let (m0, o0, s0) = run_calls(mesh, projector, budget, &full, 3);
+        let (m1, o1, s1) = run_calls(mesh, projector, budget, &options, 3);
+        let triangles = |m: &roar_mesh::Mesh| -> Vec<[u32; 3]> {
+            m.faces()
+                .map(|f| m.face_vertices(f).map(|v| v.raw()))
+                .collect()
+        };
+        assert_eq!(triangles(&m0), triangles(&m1), "{name}: triangles differ");
+        let bits = |m: &roar_mesh::Mesh| -> Vec<[u64; 3]> {
+            m.positions()
+                .iter()
+                .map(|p| p.to_array().map(f64::to_bits))
+                .collect()
+        };
+        assert_eq!(bits(&m0), bits(&m1), "{name}: positions differ");
+        assert_eq!(o0.state(), o1.state(), "{name}: optimizer rows differ");
+        for (a, b) in s0.iter().zip(&s1) {
+            for key in ["paired_collapses", "free_collapses", "suppressed_edges"] {
+                assert_eq!(a.counters.get(key), b.counters.get(key), "{name}: {key}");
+            }
+            assert_eq!(a.accepted, b.accepted, "{name}: splits");
+            assert_eq!(a.candidates, b.candidates, "{name}: candidates");
+            paired += a.counters["paired_collapses"];
+            pruned_somewhere |= b.counters["edge_costs"] * 2 < a.counters["edge_costs"];
+        }
+    }
+    assert!(pruned_somewhere, "the pruning never skipped most edges");
+    assert!(
+        paired > 20,
+        "too few swaps to exercise the pairing: {paired}"
+    );
+}

@@ -34,7 +34,8 @@ pub use point_triangle::{closest_point_on_triangle, ray_triangle};
 pub use projector::{Projector, SphereProjector};
 pub use ray_projector::{RayCastProjector, RayProjectorOptions};
 pub use regular_sampling::{
-    RegularSamples, RegularSamplingError, RegularSamplingOptions, face_grid, regular_samples,
+    RegularSamples, RegularSamplingError, RegularSamplingOptions, SamplePoints, face_grid,
+    grid_point_count, regular_sample_points, regular_sample_points_into, regular_samples,
 };
 pub use sampling::{SurfaceSamples, sample_surface};
 pub use self_intersections::{face_intersects_any, intersecting_pairs, self_intersecting_faces};
