@@ -26,7 +26,7 @@ mod solid;
 mod surface;
 mod voxelize;
 
-pub use initial::{InitialMeshOptions, InitialMeshStats, initial_mesh};
+pub use initial::{InitialMeshOptions, InitialMeshStats, initial_mesh, initial_mesh_from_init};
 
 use glam::DVec3;
 use grid::{Grid, SOLID};
