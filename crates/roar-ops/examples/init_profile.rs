@@ -1,9 +1,34 @@
 //! Times the initial mesh (watertight init, then QEM to ≤ 20k faces) on the given mesh files, for
 //! profiling: `cargo run --release -p roar-ops --example init_profile -- FILE...`.
-//! `ROAR_MAX_FACES=N` changes the face cap.
+//! `ROAR_MAX_FACES=N` changes the face cap (a large value skips the decimation). Prints the
+//! stage times and a checksum of the result, to see whether a change kept the output identical.
+//! For repeatable instruction counts:
+//! `RAYON_NUM_THREADS=1 valgrind --tool=callgrind target/release/examples/init_profile FILE`.
 
+use roar_mesh::Mesh;
 use roar_ops::init::{InitialMeshOptions, initial_mesh};
 use std::path::Path;
+
+/// FNV-1a over the bits of the positions and the triangle indices.
+fn checksum(mesh: &Mesh) -> u64 {
+    let (p, t) = mesh.to_triangles();
+    let mut h: u64 = 0xcbf29ce484222325;
+    let mut eat = |x: u64| {
+        h ^= x;
+        h = h.wrapping_mul(0x100000001b3);
+    };
+    for q in p {
+        for x in [q.x, q.y, q.z] {
+            eat(x.to_bits());
+        }
+    }
+    for tri in t {
+        for i in tri {
+            eat(u64::from(i));
+        }
+    }
+    h
+}
 
 fn main() {
     let max_faces = std::env::var("ROAR_MAX_FACES")
@@ -16,15 +41,16 @@ fn main() {
     };
     for arg in std::env::args().skip(1) {
         let soup = roar_io::read_mesh(Path::new(&arg)).expect("readable mesh");
-        let (_, stats) =
+        let (mesh, stats) =
             initial_mesh(&soup.positions, &soup.triangles, &options).expect("initial mesh");
         println!(
-            "{arg}: init {:.2}s ({} faces), build {:.2}s, decimate {:.2}s -> {} faces",
+            "{arg}: init {:.2}s ({} faces), build {:.2}s, decimate {:.2}s -> {} faces, checksum {:016x}",
             stats.init_seconds,
             stats.init_faces,
             stats.build_seconds,
             stats.decimate_seconds,
-            stats.final_faces
+            stats.final_faces,
+            checksum(&mesh)
         );
     }
 }

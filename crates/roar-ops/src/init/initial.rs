@@ -1,6 +1,6 @@
 //! The pipeline's initial mesh (spec §4.1: watertight init, then QEM to at most 20k faces).
 
-use super::{InitError, InitOptions, InitStats, watertight_init};
+use super::{InitError, InitOptions, InitStats, WatertightInit, watertight_init};
 use crate::qem::{DecimateOptions, DecimateStats, decimate, minimum_faces};
 use glam::DVec3;
 use roar_mesh::Mesh;
@@ -59,14 +59,23 @@ pub fn initial_mesh(
     triangles: &[[u32; 3]],
     options: &InitialMeshOptions,
 ) -> Result<(Mesh, InitialMeshStats), InitError> {
-    if options.max_faces < 4 {
-        return Err(InitError::InvalidOptions(
-            "max_faces must be at least 4 (a tetrahedron)".into(),
-        ));
-    }
+    check_max_faces(options)?;
     let start = Instant::now();
     let init = watertight_init(positions, triangles, &options.init)?;
     let init_seconds = start.elapsed().as_secs_f64();
+    initial_mesh_from_init(init, init_seconds, options)
+}
+
+/// The second half of [`initial_mesh`], for callers that already hold the watertight init (e.g.
+/// to inspect the voxel surface before decimation): builds the half-edge mesh and decimates it to
+/// at most `options.max_faces` faces (`options.init` is not used). `init_seconds` is reported in
+/// the stats as the init's wall time. Same promises as [`initial_mesh`].
+pub fn initial_mesh_from_init(
+    init: WatertightInit,
+    init_seconds: f64,
+    options: &InitialMeshOptions,
+) -> Result<(Mesh, InitialMeshStats), InitError> {
+    check_max_faces(options)?;
     let init_faces = init.triangles.len();
 
     let start = Instant::now();
@@ -100,4 +109,14 @@ pub fn initial_mesh(
             decimate_seconds,
         },
     ))
+}
+
+/// `max_faces` must allow at least a tetrahedron.
+fn check_max_faces(options: &InitialMeshOptions) -> Result<(), InitError> {
+    if options.max_faces < 4 {
+        return Err(InitError::InvalidOptions(
+            "max_faces must be at least 4 (a tetrahedron)".into(),
+        ));
+    }
+    Ok(())
 }

@@ -26,7 +26,7 @@ mod solid;
 mod surface;
 mod voxelize;
 
-pub use initial::{InitialMeshOptions, InitialMeshStats, initial_mesh};
+pub use initial::{InitialMeshOptions, InitialMeshStats, initial_mesh, initial_mesh_from_init};
 
 use glam::DVec3;
 use grid::{Grid, SOLID};
@@ -217,7 +217,7 @@ pub fn watertight_init(
     let voxel = (max - min).max_element() / options.resolution.max(1) as f64;
     let (split_positions, split_triangles) = split_long_edges(&soup, 4.0 * voxel);
     let bvh = TriangleBvh::build(&split_positions, &split_triangles);
-    let closest = |p: DVec3| bvh.closest_point(p).map(|c| c.point);
+    let closest = |p: DVec3, bound: f64| bvh.closest_point_within(p, bound).map(|c| c.point);
     watertight_init_from(&soup, triangles.len(), options, &closest)
 }
 
@@ -277,7 +277,8 @@ pub fn watertight_init_with(
     closest: &(dyn Fn(DVec3) -> Option<DVec3> + Sync),
 ) -> Result<WatertightInit, InitError> {
     let soup = valid_triangles(positions, triangles)?;
-    watertight_init_from(&soup, triangles.len(), options, closest)
+    let unbounded = |p: DVec3, _bound: f64| closest(p);
+    watertight_init_from(&soup, triangles.len(), options, &unbounded)
 }
 
 /// Checks indices and coordinates; returns the non-degenerate triangles (never empty).
@@ -346,7 +347,7 @@ fn watertight_init_from(
     soup: &[[DVec3; 3]],
     input_triangles: usize,
     options: &InitOptions,
-    closest: &(dyn Fn(DVec3) -> Option<DVec3> + Sync),
+    closest: &project::Closest,
 ) -> Result<WatertightInit, InitError> {
     check_options(options)?;
     let (min, max) = soup_bounds(soup);

@@ -49,31 +49,41 @@ struct Adjacency {
     neighbours: Vec<u32>,
 }
 
+/// Vertex → faces (in increasing face order) and vertex → neighbours (sorted, distinct), as
+/// compressed rows; built by counting, in time linear in the mesh.
 fn adjacency(n_vertices: usize, triangles: &[[u32; 3]]) -> Adjacency {
-    let mut face_pairs: Vec<(u32, u32)> = Vec::with_capacity(triangles.len() * 3);
-    let mut edge_pairs: Vec<(u32, u32)> = Vec::with_capacity(triangles.len() * 6);
-    for (f, t) in triangles.iter().enumerate() {
-        for k in 0..3 {
-            face_pairs.push((t[k], f as u32));
-            edge_pairs.push((t[k], t[(k + 1) % 3]));
-            edge_pairs.push((t[(k + 1) % 3], t[k]));
+    let mut face_start = vec![0u32; n_vertices + 1];
+    for t in triangles {
+        for &v in t {
+            face_start[v as usize + 1] += 1;
         }
     }
-    face_pairs.sort_unstable();
-    edge_pairs.sort_unstable();
-    edge_pairs.dedup();
-    let csr = |pairs: &[(u32, u32)]| {
-        let mut start = vec![0u32; n_vertices + 1];
-        for &(v, _) in pairs {
-            start[v as usize + 1] += 1;
+    for v in 0..n_vertices {
+        face_start[v + 1] += face_start[v];
+    }
+    let mut fill = face_start.clone();
+    let mut faces = vec![0u32; 3 * triangles.len()];
+    for (f, t) in triangles.iter().enumerate() {
+        for &v in t {
+            faces[fill[v as usize] as usize] = f as u32;
+            fill[v as usize] += 1;
         }
-        for v in 0..n_vertices {
-            start[v + 1] += start[v];
+    }
+    let mut neighbour_start = Vec::with_capacity(n_vertices + 1);
+    let mut neighbours = Vec::with_capacity(2 * faces.len());
+    let mut ring: Vec<u32> = Vec::new();
+    neighbour_start.push(0u32);
+    for v in 0..n_vertices {
+        ring.clear();
+        let (s, e) = (face_start[v] as usize, face_start[v + 1] as usize);
+        for &f in &faces[s..e] {
+            ring.extend(triangles[f as usize].iter().filter(|&&u| u as usize != v));
         }
-        (start, pairs.iter().map(|p| p.1).collect::<Vec<u32>>())
-    };
-    let (face_start, faces) = csr(&face_pairs);
-    let (neighbour_start, neighbours) = csr(&edge_pairs);
+        ring.sort_unstable();
+        ring.dedup();
+        neighbours.extend_from_slice(&ring);
+        neighbour_start.push(neighbours.len() as u32);
+    }
     Adjacency {
         face_start,
         faces,
@@ -82,25 +92,31 @@ fn adjacency(n_vertices: usize, triangles: &[[u32; 3]]) -> Adjacency {
     }
 }
 
-/// For each triangle, the triangle across each of its edges (`u32::MAX` if none).
-fn faces_across_edges(triangles: &[[u32; 3]]) -> Vec<[u32; 3]> {
-    let mut edges: Vec<((u32, u32), u32)> = Vec::with_capacity(triangles.len() * 3);
-    for (f, t) in triangles.iter().enumerate() {
-        for k in 0..3 {
-            edges.push(((t[k], t[(k + 1) % 3]), f as u32));
-        }
-    }
-    edges.sort_unstable();
-    let mut across = vec![[u32::MAX; 3]; triangles.len()];
-    for (f, t) in triangles.iter().enumerate() {
-        for k in 0..3 {
-            let twin = (t[(k + 1) % 3], t[k]);
-            if let Ok(i) = edges.binary_search_by(|e| e.0.cmp(&twin)) {
-                across[f][k] = edges[i].1;
-            }
-        }
-    }
-    across
+/// For each triangle, the triangle across each of its edges (`u32::MAX` if none): the face
+/// around the edge's first vertex that holds the opposite directed edge (the surface is a
+/// manifold, so there is at most one).
+fn faces_across_edges(triangles: &[[u32; 3]], adj: &Adjacency) -> Vec<[u32; 3]> {
+    let has_directed = |g: u32, from: u32, to: u32| {
+        let t = triangles[g as usize];
+        (0..3).any(|k| t[k] == from && t[(k + 1) % 3] == to)
+    };
+    triangles
+        .iter()
+        .map(|t| {
+            [0, 1, 2].map(|k| {
+                let (a, b) = (t[k], t[(k + 1) % 3]);
+                let (s, e) = (
+                    adj.face_start[a as usize] as usize,
+                    adj.face_start[a as usize + 1] as usize,
+                );
+                adj.faces[s..e]
+                    .iter()
+                    .copied()
+                    .find(|&g| has_directed(g, b, a))
+                    .unwrap_or(u32::MAX)
+            })
+        })
+        .collect()
 }
 
 /// Outward normal sign of the boundary square with min corner `q` and normal axis `a`, if it is a
@@ -126,8 +142,40 @@ fn square_side(grid: &Grid, state: &[u8], q: [i64; 3], a: usize) -> Option<i8> {
 
 /// Clearance of each quad (in voxels, capped at `cap`): distance to the nearest opposite-facing
 /// boundary square that shares no vertex with it.
+///
+/// Candidate squares are visited nearest first (offsets sorted by their box distance, which
+/// depends on the offset only), so the search stops at the first opposite-facing square, and
+/// offsets at distance ≥ `cap` (which cannot lower the capped result) are never visited.
 fn quad_clearances(grid: &Grid, state: &[u8], surface: &VoxelSurface, cap: usize) -> Vec<f64> {
     let k = cap as i64;
+    // Per normal axis: (squared box distance, offset) of the parallel squares with
+    // 0 < distance < cap, nearest first.
+    let offsets: [Vec<(i64, [i64; 3])>; 3] = [0, 1, 2].map(|a| {
+        let mut list = Vec::new();
+        for dk in -k..=k {
+            for dj in -k..=k {
+                for di in -k..=k {
+                    let d = [di, dj, dk];
+                    // Box distance between two parallel unit squares with integer corners.
+                    let d2: i64 = (0..3)
+                        .map(|b| {
+                            let gap = if b == a {
+                                d[b].abs()
+                            } else {
+                                (d[b].abs() - 1).max(0)
+                            };
+                            gap * gap
+                        })
+                        .sum();
+                    if d2 > 0 && d2 < k * k {
+                        list.push((d2, d));
+                    }
+                }
+            }
+        }
+        list.sort_by_key(|&(d2, _)| d2);
+        list
+    });
     surface
         .quads
         .par_iter()
@@ -135,34 +183,61 @@ fn quad_clearances(grid: &Grid, state: &[u8], surface: &VoxelSurface, cap: usize
             let a = quad.axis;
             let sign = quad.normal[a];
             let p = quad.min_corner.map(|x| x as i64);
-            let mut best = cap as f64;
-            for dk in -k..=k {
-                for dj in -k..=k {
-                    for di in -k..=k {
-                        let q = [p[0] + di, p[1] + dj, p[2] + dk];
-                        let Some(side) = square_side(grid, state, q, a) else {
-                            continue;
-                        };
-                        if f64::from(side) * sign >= 0.0 {
-                            continue;
-                        }
-                        // Box distance between two parallel unit squares with integer corners.
-                        let mut d2 = 0i64;
-                        for b in 0..3 {
-                            let (lo1, hi1) = (p[b], p[b] + i64::from(b != a));
-                            let (lo2, hi2) = (q[b], q[b] + i64::from(b != a));
-                            let gap = (lo2 - hi1).max(lo1 - hi2).max(0);
-                            d2 += gap * gap;
-                        }
-                        if d2 > 0 {
-                            best = best.min((d2 as f64).sqrt());
-                        }
-                    }
+            for &(d2, d) in &offsets[a] {
+                let q = [p[0] + d[0], p[1] + d[1], p[2] + d[2]];
+                let Some(side) = square_side(grid, state, q, a) else {
+                    continue;
+                };
+                if f64::from(side) * sign < 0.0 {
+                    return (d2 as f64).sqrt();
                 }
             }
-            best
+            cap as f64
         })
         .collect()
+}
+
+/// A closest-point query on the target: `closest(p, bound)` is the point of the target nearest
+/// to `p`, where `bound` is an upper bound on that distance (`f64::INFINITY` when unknown) which
+/// the query may use to prune. It must give the same point as without a bound whenever the
+/// nearest point lies within `bound`, and may give `None` otherwise.
+pub(crate) type Closest<'a> = dyn Fn(DVec3, f64) -> Option<DVec3> + Sync + 'a;
+
+/// Brings `targets[v]` to the closest target point of `positions[v]` for every vertex, reusing
+/// the previous answer: a vertex that has not moved since `queried_at[v]` keeps its target (the
+/// same query would give the same point), and one that moved searches only within its distance
+/// to its old target (which lies on the target, so the nearest point is at least that close;
+/// enlarged by a relative 1e-9 and by `slack` against rounding, so that a vertex sitting on its
+/// target still gets a non-empty search). Exactly the points of fresh unbounded queries; the
+/// later rounds, where vertices move little, cost a half to a third of an unbounded round.
+fn refresh_targets(
+    positions: &[DVec3],
+    closest: &Closest,
+    slack: f64,
+    targets: &mut [Option<DVec3>],
+    queried_at: &mut [DVec3],
+) {
+    targets
+        .par_iter_mut()
+        .zip(queried_at.par_iter_mut())
+        .zip(positions.par_iter())
+        .for_each(|((target, at), &p)| {
+            if *at == p {
+                return;
+            }
+            let bound = target.map_or(f64::INFINITY, |old| {
+                let d = p.distance(old);
+                d + d * 1e-9 + slack
+            });
+            *target = closest(p, bound).or_else(|| {
+                if bound.is_finite() {
+                    closest(p, f64::INFINITY)
+                } else {
+                    None
+                }
+            });
+            *at = p;
+        });
 }
 
 /// Moves the surface toward the target (closest-point function), obeying the non-crossing rule
@@ -172,7 +247,7 @@ pub(crate) fn project_surface(
     grid: &Grid,
     state: &[u8],
     surface: &mut VoxelSurface,
-    closest: &(dyn Fn(DVec3) -> Option<DVec3> + Sync),
+    closest: &Closest,
     params: &ProjectParams,
 ) -> ProjectCounts {
     let n = surface.positions.len();
@@ -199,8 +274,10 @@ pub(crate) fn project_surface(
         .collect();
     let min_double_area = 1e-4 * h * h;
     let triangles = &surface.triangles;
-    let across = faces_across_edges(triangles);
-    let unit_normal = |positions: &[DVec3], f: usize, v: usize, candidate: DVec3| -> DVec3 {
+    let across = faces_across_edges(triangles, &adj);
+    // The cross product (twice the area, along the normal) of face `f` with `v` moved to
+    // `candidate`.
+    let moved_cross = |positions: &[DVec3], f: usize, v: usize, candidate: DVec3| -> DVec3 {
         let p = triangles[f].map(|i| {
             if i as usize == v {
                 candidate
@@ -208,22 +285,19 @@ pub(crate) fn project_surface(
                 positions[i as usize]
             }
         });
-        (p[1] - p[0]).cross(p[2] - p[0]).normalize_or_zero()
+        (p[1] - p[0]).cross(p[2] - p[0])
     };
+    // A dihedral test `n_f · n_g > min_dihedral_dot` between unit normals passes whenever the
+    // unnormalized cross products have a non-negative dot (angle ≤ 90°) and the bound is
+    // negative: the normalized dot is then ≥ 0 up to rounding (≪ 1e-9). Only the rare folds past
+    // 90° pay for the two normalizations, and the answer is the same as always normalizing.
+    let dihedral_fast_path = params.min_dihedral_dot < -1e-9;
 
     // Whether moving `v` to `candidate` keeps every incident triangle unfolded.
     let acceptable = |positions: &[DVec3], v: usize, candidate: DVec3| -> bool {
         let (s, e) = (adj.face_start[v] as usize, adj.face_start[v + 1] as usize);
         adj.faces[s..e].iter().all(|&f| {
-            let t = triangles[f as usize];
-            let p = t.map(|i| {
-                if i as usize == v {
-                    candidate
-                } else {
-                    positions[i as usize]
-                }
-            });
-            let nrm = (p[1] - p[0]).cross(p[2] - p[0]);
+            let nrm = moved_cross(positions, f as usize, v, candidate);
             let len = nrm.length();
             if len < min_double_area
                 || nrm.dot(face_normal[f as usize]) < params.min_normal_dot * len
@@ -231,11 +305,15 @@ pub(crate) fn project_surface(
                 return false;
             }
             // No fold across the face's edges (dihedral angle kept below about 120°).
-            let n = nrm / len;
             across[f as usize].iter().all(|&g| {
-                g == u32::MAX
-                    || n.dot(unit_normal(positions, g as usize, v, candidate))
-                        > params.min_dihedral_dot
+                if g == u32::MAX {
+                    return true;
+                }
+                let other = moved_cross(positions, g as usize, v, candidate);
+                if dihedral_fast_path && nrm.dot(other) >= 0.0 {
+                    return true;
+                }
+                (nrm / len).dot(other.normalize_or_zero()) > params.min_dihedral_dot
             })
         })
     };
@@ -260,8 +338,12 @@ pub(crate) fn project_surface(
     };
 
     let positions = &mut surface.positions;
+    let mut targets: Vec<Option<DVec3>> = vec![None; n];
+    // NaN compares unequal to every position, so the first refresh queries every vertex.
+    let mut queried_at = vec![DVec3::NAN; n];
+    let slack = 1e-9 * h;
     for round in 0..params.rounds {
-        let targets: Vec<Option<DVec3>> = positions.par_iter().map(|p| closest(*p)).collect();
+        refresh_targets(positions, closest, slack, &mut targets, &mut queried_at);
         for v in 0..n {
             let Some(target) = targets[v] else { continue };
             let mut delta = target - positions[v];
@@ -304,9 +386,11 @@ pub(crate) fn project_surface(
             try_move(positions, v, delta * params.relax_weight);
         }
     }
+    refresh_targets(positions, closest, slack, &mut targets, &mut queried_at);
     let distances: Vec<f64> = positions
-        .par_iter()
-        .map(|p| closest(*p).map_or(0.0, |q| (q - *p).length()))
+        .iter()
+        .zip(&targets)
+        .map(|(p, t)| t.map_or(0.0, |q| (q - *p).length()))
         .collect();
     counts.mean_distance = distances.iter().sum::<f64>() / n as f64;
     counts.max_distance = distances.iter().copied().fold(0.0, f64::max);
