@@ -135,6 +135,13 @@ pub fn run(args: &ReconstructArgs) -> anyhow::Result<()> {
         run: result.stats,
         config,
     };
+    if let Some(iteration) = report.run.finished_from_checkpoint {
+        eprintln!(
+            "note: {} faces of the last loop mesh could not be untangled; finished from the \
+             intersection-free mesh of iteration {iteration}",
+            report.run.unresolved_after_loop
+        );
+    }
     let json = serde_json::to_string_pretty(&report)?;
     if let Some(path) = &args.report {
         roar_io::atomic_write(path, |w| w.write_all(json.as_bytes()))?;

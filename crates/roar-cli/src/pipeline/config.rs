@@ -87,6 +87,10 @@ pub struct ReconstructConfig {
     pub split_threshold: f64,
     /// Tangential smoothing every this many iterations (§1.3, OQ-13: 5; 0 = off).
     pub smoothing_interval: usize,
+    /// Every this many iterations, keep a copy of the loop's mesh if it has no self-intersection
+    /// (0 = off). When the final untangle cannot clear the last mesh, the run finishes from the
+    /// newest such copy (the report says which), instead of failing. [INF] Not in the paper.
+    pub checkpoint_interval: usize,
     /// Shorten optimizer steps that would make faces intersect (`roar_ops::untangle::limit_steps`),
     /// so the loop itself keeps the mesh intersection-free where the blocks did.
     pub step_limiter: bool,
@@ -129,6 +133,7 @@ impl Default for ReconstructConfig {
             split_interval: 10,
             split_threshold: 0.02,
             smoothing_interval: 5,
+            checkpoint_interval: 10,
             step_limiter: true,
             untangle_margin: 1e-6,
             best_effort: false,

@@ -24,7 +24,7 @@ use roar_loss::{
     PointCloudOptions, RenderLoss, SharpEdgeOptions, Target, TargetOptions, WeightedSum,
     build_target, point_cloud, sharp_edge_samples,
 };
-use roar_mesh::spatial::TriangleBvh;
+use roar_mesh::spatial::{TriangleBvh, self_intersecting_faces};
 use roar_mesh::{EdgeId, Mesh};
 use roar_ops::block::{Block, BlockContext, BlockStats};
 use roar_ops::collapse_block::{FaceCollapse, FaceCollapseOptions};
@@ -135,6 +135,11 @@ pub struct RunStats {
     pub steps_shortened: usize,
     /// Edge splits used to fill up to N.
     pub fill_splits: usize,
+    /// Faces the untangle block could not clear on the loop's last mesh (0 when it could).
+    pub unresolved_after_loop: usize,
+    /// When that happened: the iteration of the intersection-free checkpoint the run finished
+    /// from instead (0 = the init at the working budget).
+    pub finished_from_checkpoint: Option<usize>,
     /// Untangle statistics.
     pub untangle_initial_pairs: usize,
     /// Rounds the untangle block needed.
@@ -263,6 +268,8 @@ impl Reconstruction {
             },
         )
         .map_err(|e| PipelineError::Config(e.to_string()))?;
+        // The init at the working budget is intersection-free (init and QEM promise it).
+        let mut checkpoint = (0, mesh.clone());
         clock.lap("loop_setup");
 
         for iteration in 0..config.iterations {
@@ -311,28 +318,30 @@ impl Reconstruction {
                     clock.lap(&format!("loop_block_{}", scheduled.block.name()));
                 }
             }
+            let done = iteration + 1;
+            if config.checkpoint_interval > 0 && done % config.checkpoint_interval == 0 {
+                if is_intersection_free(&mesh) {
+                    checkpoint = (done, mesh.clone());
+                }
+                clock.lap("loop_checkpoint");
+            }
             report("optimize", iteration, value, mesh.n_faces());
         }
         stats.loop_faces = mesh.n_faces();
         drop(loss);
 
         report("finish", config.iterations, stats.loss_last, mesh.n_faces());
-        stats.fill_splits = fill_to_budget(&mut mesh, config.faces);
-        clock.lap("fill_to_budget");
-
-        let untangled = untangle(
-            &mut mesh,
-            &UntangleOptions {
-                margin_rel: config.untangle_margin,
-                ..UntangleOptions::default()
-            },
-        );
-        record_untangle(&mut stats, &untangled);
+        let mut unresolved = fill_and_untangle(&mut mesh, &config, &mut stats);
         clock.lap("untangle");
-        if !untangled.unresolved_faces.is_empty() {
-            return Err(PipelineError::Intersections(
-                untangled.unresolved_faces.len(),
-            ));
+        if unresolved > 0 && config.checkpoint_interval > 0 {
+            stats.unresolved_after_loop = unresolved;
+            stats.finished_from_checkpoint = Some(checkpoint.0);
+            mesh = checkpoint.1;
+            unresolved = fill_and_untangle(&mut mesh, &config, &mut stats);
+            clock.lap("untangle");
+        }
+        if unresolved > 0 {
+            return Err(PipelineError::Intersections(unresolved));
         }
 
         report(
@@ -522,6 +531,27 @@ fn fill_to_budget(mesh: &mut Mesh, faces: usize) -> usize {
     }
     mesh.compact();
     splits
+}
+
+/// Fills the mesh up to `config.faces` and runs the untangle block; returns how many faces it
+/// could not clear.
+fn fill_and_untangle(mesh: &mut Mesh, config: &ReconstructConfig, stats: &mut RunStats) -> usize {
+    stats.fill_splits = fill_to_budget(mesh, config.faces);
+    let untangled = untangle(
+        mesh,
+        &UntangleOptions {
+            margin_rel: config.untangle_margin,
+            ..UntangleOptions::default()
+        },
+    );
+    record_untangle(stats, &untangled);
+    untangled.unresolved_faces.len()
+}
+
+/// Whether no two non-adjacent faces of `mesh` intersect (exact test).
+fn is_intersection_free(mesh: &Mesh) -> bool {
+    let (positions, triangles) = mesh.to_triangles();
+    !self_intersecting_faces(&positions, &triangles).contains(&true)
 }
 
 /// The guaranteed QEM to exactly `config.faces` (best effort only if configured).
