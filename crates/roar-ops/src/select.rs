@@ -55,6 +55,34 @@ pub fn select_independent_edges(
 /// result; the passes cost about 30 E per round, the searches about 1000 per pool edge).
 const SPARSE_DIVISOR: usize = 32;
 
+/// Per edge slot: its priority if the edge is alive and the priority positive, else 0.
+fn live_priorities(mesh: &Mesh, priority: &[f64]) -> Vec<f64> {
+    (0..mesh.edge_capacity())
+        .map(|i| {
+            let p = priority.get(i).copied().unwrap_or(0.0);
+            if mesh.is_edge_alive(EdgeId::from_index(i)) && p > 0.0 && !p.is_nan() {
+                p
+            } else {
+                0.0
+            }
+        })
+        .collect()
+}
+
+/// Per edge slot: its two vertex indices (`[0, 0]` for a dead slot).
+fn edge_ends(mesh: &Mesh) -> Vec<[usize; 2]> {
+    (0..mesh.edge_capacity())
+        .map(|i| {
+            let e = EdgeId::from_index(i);
+            if mesh.is_edge_alive(e) {
+                mesh.edge_vertices(e).map(|v| v.index())
+            } else {
+                [0, 0]
+            }
+        })
+        .collect()
+}
+
 /// [`select_independent_edges`] with the rank propagation forced to the bounded searches
 /// (`Some(true)`) or the whole-mesh passes (`Some(false)`); `None` picks by pool size.
 fn select_with(
@@ -65,26 +93,8 @@ fn select_with(
 ) -> Selection {
     let ne = mesh.edge_capacity();
     let nv = mesh.vertex_capacity();
-    let mut pri: Vec<f64> = (0..ne)
-        .map(|i| {
-            let p = priority.get(i).copied().unwrap_or(0.0);
-            if mesh.is_edge_alive(EdgeId::from_index(i)) && p > 0.0 && !p.is_nan() {
-                p
-            } else {
-                0.0
-            }
-        })
-        .collect();
-    let ends: Vec<[usize; 2]> = (0..ne)
-        .map(|i| {
-            let e = EdgeId::from_index(i);
-            if mesh.is_edge_alive(e) {
-                mesh.edge_vertices(e).map(|v| v.index())
-            } else {
-                [0, 0]
-            }
-        })
-        .collect();
+    let mut pri = live_priorities(mesh, priority);
+    let ends = edge_ends(mesh);
     let mut out = Selection::default();
     // Only entries of the current round's `order` are ever read.
     let mut rank = vec![0u32; ne];
@@ -254,26 +264,8 @@ mod tests {
     fn reference_select(mesh: &Mesh, priority: &[f64], options: &SelectOptions) -> Selection {
         let ne = mesh.edge_capacity();
         let nv = mesh.vertex_capacity();
-        let mut pri: Vec<f64> = (0..ne)
-            .map(|i| {
-                let p = priority.get(i).copied().unwrap_or(0.0);
-                if mesh.is_edge_alive(EdgeId::from_index(i)) && p > 0.0 && !p.is_nan() {
-                    p
-                } else {
-                    0.0
-                }
-            })
-            .collect();
-        let ends: Vec<[usize; 2]> = (0..ne)
-            .map(|i| {
-                let e = EdgeId::from_index(i);
-                if mesh.is_edge_alive(e) {
-                    mesh.edge_vertices(e).map(|v| v.index())
-                } else {
-                    [0, 0]
-                }
-            })
-            .collect();
+        let mut pri = live_priorities(mesh, priority);
+        let ends = edge_ends(mesh);
         let mut out = Selection::default();
         let mut rank = vec![0u32; ne];
         let mut edge_val = vec![0u32; ne];
