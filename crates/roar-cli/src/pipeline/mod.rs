@@ -533,8 +533,9 @@ fn fill_to_budget(mesh: &mut Mesh, faces: usize) -> usize {
     splits
 }
 
-/// Fills the mesh up to `config.faces` and runs the untangle block; returns how many faces it
-/// could not clear.
+/// Fills the mesh up to `config.faces`, runs the untangle block and fills again (its collapses
+/// may take the mesh below the budget, and the final QEM never adds faces; splits do not move
+/// any geometry, so no intersection comes back). Returns how many faces it could not clear.
 fn fill_and_untangle(mesh: &mut Mesh, config: &ReconstructConfig, stats: &mut RunStats) -> usize {
     stats.fill_splits = fill_to_budget(mesh, config.faces);
     let untangled = untangle(
@@ -545,6 +546,7 @@ fn fill_and_untangle(mesh: &mut Mesh, config: &ReconstructConfig, stats: &mut Ru
         },
     );
     record_untangle(stats, &untangled);
+    stats.fill_splits += fill_to_budget(mesh, config.faces);
     untangled.unresolved_faces.len()
 }
 
@@ -563,7 +565,15 @@ fn final_decimation(
         best_effort: config.best_effort,
         ..DecimateOptions::default()
     };
-    Ok(decimate(mesh, config.faces, &options)?)
+    let stats = decimate(mesh, config.faces, &options)?;
+    if mesh.n_faces() != config.faces && !config.best_effort {
+        return Err(PipelineError::Internal(format!(
+            "the output has {} faces instead of {}",
+            mesh.n_faces(),
+            config.faces
+        )));
+    }
+    Ok(stats)
 }
 
 fn record_untangle(stats: &mut RunStats, untangled: &UntangleStats) {
