@@ -5,30 +5,10 @@
 //! For repeatable instruction counts:
 //! `RAYON_NUM_THREADS=1 valgrind --tool=callgrind target/release/examples/init_profile FILE`.
 
-use roar_mesh::Mesh;
+mod common;
+
 use roar_ops::init::{InitialMeshOptions, initial_mesh};
 use std::path::Path;
-
-/// FNV-1a over the bits of the positions and the triangle indices.
-fn checksum(mesh: &Mesh) -> u64 {
-    let (p, t) = mesh.to_triangles();
-    let mut h: u64 = 0xcbf29ce484222325;
-    let mut eat = |x: u64| {
-        h ^= x;
-        h = h.wrapping_mul(0x100000001b3);
-    };
-    for q in p {
-        for x in [q.x, q.y, q.z] {
-            eat(x.to_bits());
-        }
-    }
-    for tri in t {
-        for i in tri {
-            eat(u64::from(i));
-        }
-    }
-    h
-}
 
 fn main() {
     let max_faces = std::env::var("ROAR_MAX_FACES")
@@ -50,7 +30,7 @@ fn main() {
             stats.build_seconds,
             stats.decimate_seconds,
             stats.final_faces,
-            checksum(&mesh)
+            common::mesh_checksum(&mesh)
         );
     }
 }

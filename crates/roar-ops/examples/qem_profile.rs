@@ -7,6 +7,8 @@
 //! Prints the time, stats and a checksum of the result (to see whether a change kept the
 //! output identical).
 
+mod common;
+
 use roar_mesh::Mesh;
 use roar_mesh::shapes::{perturbed, torus};
 use roar_ops::init::{InitOptions, watertight_init};
@@ -66,26 +68,6 @@ fn cpu_seconds() -> f64 {
         .map_or(0.0, |ns| ns * 1e-9)
 }
 
-fn checksum(mesh: &Mesh) -> u64 {
-    let (p, t) = mesh.to_triangles();
-    let mut h: u64 = 0xcbf29ce484222325;
-    let mut eat = |x: u64| {
-        h ^= x;
-        h = h.wrapping_mul(0x100000001b3);
-    };
-    for q in p {
-        for x in [q.x, q.y, q.z] {
-            eat(x.to_bits());
-        }
-    }
-    for tri in t {
-        for i in tri {
-            eat(i as u64);
-        }
-    }
-    h
-}
-
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
     let source = args.first().map(String::as_str).unwrap_or("torus");
@@ -113,7 +95,7 @@ fn main() {
             stats.passes,
             stats.quality_bound,
             stats.vetoes,
-            checksum(&mesh)
+            common::mesh_checksum(&mesh)
         );
     }
 }

@@ -14,6 +14,8 @@
 //! mesh, its positions' bits and the optimizer rows, plus the stats; compare two builds' lines
 //! to check that a change keeps the block's results bit-identical).
 
+mod common;
+
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use roar_mesh::shapes::{genus_n_solid, icosphere, perturbed};
@@ -64,12 +66,8 @@ fn uv_sphere(lat: usize, lon: usize) -> Mesh {
 
 /// FNV-1a over the mesh's triangles, its positions' bits and the optimizer rows' `m1`.
 fn digest(mesh: &Mesh, optimizer: &Optimizer) -> u64 {
-    let mut h = 0xcbf2_9ce4_8422_2325u64;
-    let mut eat = |x: u64| {
-        for byte in x.to_le_bytes() {
-            h = (h ^ u64::from(byte)).wrapping_mul(0x0100_0000_01b3);
-        }
-    };
+    let mut h = common::Fnv::new();
+    let mut eat = |x: u64| h.eat(x);
     for f in mesh.faces() {
         for v in mesh.face_vertices(f) {
             eat(u64::from(v.raw()));
@@ -85,7 +83,7 @@ fn digest(mesh: &Mesh, optimizer: &Optimizer) -> u64 {
             eat(c.to_bits());
         }
     }
-    h
+    h.finish()
 }
 
 /// Runs `calls` Face Split calls per scenario (seed = call index) and prints a digest line each.

@@ -18,7 +18,7 @@ use glam::DVec3;
 use roar_eval::{ChamferOptions, fidelity};
 use roar_io::{TriangleSoup, read_mesh};
 use roar_mesh::Mesh;
-use roar_mesh::spatial::{TriangleBvh, self_intersecting_faces};
+use roar_mesh::spatial::TriangleBvh;
 use roar_ops::init::{
     InitialMeshOptions, InitialMeshStats, WatertightInit, initial_mesh_from_init, watertight_init,
 };
@@ -154,14 +154,6 @@ fn shared_cases(dir: &Path) -> &'static [Case] {
     })
 }
 
-fn intersecting_faces(mesh: &Mesh) -> usize {
-    let (p, t) = mesh.to_triangles();
-    self_intersecting_faces(&p, &t)
-        .iter()
-        .filter(|&&x| x)
-        .count()
-}
-
 /// Checks the voxel surface and the initial mesh of `case`; returns its table row.
 fn check_initial_mesh(case: &Case) -> String {
     let name = &case.name;
@@ -187,7 +179,7 @@ fn check_initial_mesh(case: &Case) -> String {
     assert_eq!(mesh.n_faces(), stats.final_faces);
     let volume = mesh.signed_volume();
     assert!(volume > 0.0, "{name}: volume {volume}");
-    let crossing = intersecting_faces(mesh);
+    let crossing = common::intersecting_faces(mesh);
     assert_eq!(crossing, 0, "{name}: {crossing} self-intersecting faces");
     let (positions, triangles) = mesh.to_triangles();
     let chamfer_options = ChamferOptions {
@@ -269,7 +261,7 @@ fn check_decimated(name: &str, budget: usize, m: &Mesh, genera: &[usize]) {
         after, genera,
         "{name} @ {budget}: components/genera changed"
     );
-    let crossing = intersecting_faces(m);
+    let crossing = common::intersecting_faces(m);
     assert_eq!(
         crossing, 0,
         "{name} @ {budget}: {crossing} self-intersecting faces"

@@ -1,18 +1,11 @@
 //! QEM decimation: exact budgets, no new self-intersections, topology kept, clear errors.
 
+mod common;
+
 use proptest::prelude::*;
 use roar_mesh::Mesh;
 use roar_mesh::shapes::{icosphere, perturbed, torus};
-use roar_mesh::spatial::self_intersecting_faces;
 use roar_ops::qem::{DecimateError, DecimateOptions, decimate, decimate_with, minimum_faces};
-
-fn intersecting_faces(mesh: &Mesh) -> usize {
-    let (p, t) = mesh.to_triangles();
-    self_intersecting_faces(&p, &t)
-        .iter()
-        .filter(|&&x| x)
-        .count()
-}
 
 /// Decimates a copy to `target` and checks every promise of `decimate`.
 fn decimate_and_check(mesh: &Mesh, target: usize) -> Mesh {
@@ -27,7 +20,7 @@ fn decimate_and_check(mesh: &Mesh, target: usize) -> Mesh {
     assert_eq!(m.components().0, components);
     assert_eq!(m.genus(), genus);
     assert_eq!(
-        intersecting_faces(&m),
+        common::intersecting_faces(&m),
         0,
         "self-intersections after decimation to {target}"
     );
@@ -158,7 +151,7 @@ fn blocked_budget_is_a_named_error_or_the_closest_mesh_with_best_effort() {
         "best effort keeps the same closest mesh"
     );
     m.validate().unwrap();
-    assert_eq!(intersecting_faces(&m), 0);
+    assert_eq!(common::intersecting_faces(&m), 0);
 }
 
 proptest! {
@@ -172,7 +165,7 @@ proptest! {
     ) {
         let base = if use_torus { torus(20, 10, 1.0, 0.4) } else { icosphere(3) };
         let mesh = perturbed(&base, amplitude, seed);
-        let clean = intersecting_faces(&mesh) == 0;
+        let clean = common::intersecting_faces(&mesh) == 0;
         let target = ((base.n_faces() as f64 * frac) as usize / 2 * 2).max(minimum_faces(&base));
         let mut m = mesh.clone();
         let opts = DecimateOptions { best_effort: true, ..DecimateOptions::default() };
@@ -181,7 +174,7 @@ proptest! {
         prop_assert_eq!(m.genus(), base.genus());
         prop_assert!(m.n_faces() >= target);
         if clean {
-            prop_assert_eq!(intersecting_faces(&m), 0);
+            prop_assert_eq!(common::intersecting_faces(&m), 0);
         }
         if stats.reached_target {
             prop_assert_eq!(m.n_faces(), target);
