@@ -1,9 +1,11 @@
 //! The pipeline at toy settings (few views, low resolution, few iterations), fast enough for the
 //! default test run: its promises hold and it is deterministic.
 
-use roar_cli::pipeline::{InitKind, ReconstructConfig, Reconstruction};
+use roar_cli::pipeline::{InitKind, ReconstructConfig, Reconstruction, RunStats, ScheduledBlock};
 use roar_mesh::Mesh;
 use roar_mesh::spatial::self_intersecting_faces;
+use roar_ops::block::{Block, BlockContext, BlockStats};
+use roar_ops::optim::Optimizer;
 
 fn toy_config(faces: usize) -> ReconstructConfig {
     ReconstructConfig {
@@ -24,10 +26,21 @@ fn toy_config(faces: usize) -> ReconstructConfig {
 }
 
 fn run(config: ReconstructConfig) -> (Vec<glam::DVec3>, Vec<[u32; 3]>, usize) {
+    let (positions, triangles, stats) = run_with(config, Vec::new());
+    (positions, triangles, stats.init_components)
+}
+
+/// Runs the toy pipeline with `extra` blocks scheduled after the default ones.
+fn run_with(
+    config: ReconstructConfig,
+    extra: Vec<ScheduledBlock>,
+) -> (Vec<glam::DVec3>, Vec<[u32; 3]>, RunStats) {
     let soup = roar_cli::example::chair_soup();
     let config_iterations = config.iterations;
     let mut stages = Vec::new();
-    let out = Reconstruction::new(config)
+    let mut reconstruction = Reconstruction::new(config);
+    reconstruction.blocks.extend(extra);
+    let out = reconstruction
         .run(&soup.positions, &soup.triangles, &mut |p| {
             stages.push(p.stage)
         })
@@ -43,7 +56,63 @@ fn run(config: ReconstructConfig) -> (Vec<glam::DVec3>, Vec<[u32; 3]>, usize) {
         let sum: f64 = record.terms.values().sum();
         assert!((sum - record.loss).abs() <= 1e-12 * record.loss.abs().max(1.0));
     }
-    (out.positions, out.triangles, out.stats.init_components)
+    (out.positions, out.triangles, out.stats)
+}
+
+/// Throws every vertex to a pseudo-random point of the unit box once, at one iteration: a
+/// tangle of crossings far beyond what the untangle block can resolve.
+struct Scramble {
+    at_iteration: usize,
+}
+
+impl Block for Scramble {
+    fn name(&self) -> &'static str {
+        "scramble"
+    }
+
+    fn apply(&mut self, mesh: &mut Mesh, _: &mut Optimizer, ctx: &BlockContext) -> BlockStats {
+        let mut stats = BlockStats::new(self.name());
+        if ctx.iteration == self.at_iteration {
+            let mut state = 0x9E37_79B9_7F4A_7C15u64;
+            let mut next = || {
+                state ^= state << 13;
+                state ^= state >> 7;
+                state ^= state << 17;
+                (state >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+            };
+            for p in mesh.positions_mut() {
+                *p = glam::DVec3::new(next(), next(), next());
+            }
+            stats.accepted = mesh.n_vertices();
+        }
+        stats
+    }
+}
+
+#[test]
+fn a_tangle_the_untangle_cannot_clear_finishes_from_the_newest_clean_checkpoint() {
+    let config = ReconstructConfig {
+        checkpoint_interval: 2,
+        ..toy_config(300)
+    };
+    // Scrambled at iteration 4, after the checkpoint taken when 4 iterations were done; the
+    // checkpoint after 6 iterations sees the tangle and is not taken.
+    let scramble = ScheduledBlock {
+        block: Box::new(Scramble { at_iteration: 4 }),
+        every: 1,
+        skip_first: false,
+    };
+    let (positions, triangles, stats) = run_with(config, vec![scramble]);
+    assert!(
+        stats.unresolved_after_loop > 0,
+        "the untangle cleared the tangle"
+    );
+    assert_eq!(stats.finished_from_checkpoint, Some(4));
+    assert_eq!(triangles.len(), 300);
+    let mesh = Mesh::from_triangles(positions.clone(), &triangles).unwrap();
+    mesh.validate().unwrap();
+    assert!(mesh.signed_volume() > 0.0);
+    assert!(!self_intersecting_faces(&positions, &triangles).contains(&true));
 }
 
 #[test]

@@ -608,3 +608,54 @@ impl StageClock {
         self.last = Some(now);
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use roar_mesh::shapes::icosphere;
+
+    /// Two unit icospheres whose centres are `distance` apart, as one mesh of two pieces.
+    fn two_spheres(distance: f64) -> Mesh {
+        let (mut positions, mut triangles) = icosphere(2).to_triangles();
+        let n = positions.len() as u32;
+        let moved: Vec<DVec3> = positions.iter().map(|p| *p + DVec3::X * distance).collect();
+        let shifted: Vec<[u32; 3]> = triangles.iter().map(|t| t.map(|v| v + n)).collect();
+        positions.extend(moved);
+        triangles.extend(shifted);
+        Mesh::from_triangles(positions, &triangles).unwrap()
+    }
+
+    #[test]
+    fn untangling_that_collapses_edges_is_filled_back_to_the_budget() {
+        // Slivers on the first sphere where it crosses the second: the untangle block collapses
+        // crossing slivers at once instead of moving them.
+        let mut mesh = two_spheres(1.9);
+        let centre = DVec3::X * 1.9;
+        let inside = |p: DVec3| (p - centre).length() < 1.0;
+        let crossing: Vec<EdgeId> = mesh
+            .edges()
+            .filter(|&e| {
+                let [a, b] = mesh.edge_vertices(e).map(|v| mesh.position(v));
+                a.x < 1.0 && inside(a) != inside(b)
+            })
+            .collect();
+        assert!(!crossing.is_empty());
+        for e in crossing {
+            mesh.split_edge(e, 0.02);
+        }
+        let faces = mesh.n_faces();
+        let config = ReconstructConfig {
+            faces,
+            ..ReconstructConfig::default()
+        };
+        let mut stats = RunStats::default();
+        let unresolved = fill_and_untangle(&mut mesh, &config, &mut stats);
+        assert_eq!(unresolved, 0);
+        // The mesh started at the budget, so every split refilled a face the untangle removed.
+        assert!(stats.untangle_initial_pairs > 0);
+        assert!(stats.fill_splits > 0, "the untangle collapsed nothing");
+        mesh.validate().unwrap();
+        assert_eq!(mesh.n_faces(), faces);
+        assert!(is_intersection_free(&mesh));
+    }
+}
