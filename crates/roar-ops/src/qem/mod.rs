@@ -29,7 +29,7 @@ mod grid;
 mod heap;
 mod quadric;
 
-use crate::intersect::faces_intersect_filtered;
+use crate::intersect::{faces_intersect_filtered, fan_is_embedded};
 use glam::DVec3;
 use grid::{Box32, FaceGrid};
 use heap::EdgeHeap;
@@ -371,6 +371,8 @@ struct Decimator<'m, F: FnMut(&Collapse)> {
     fan_scratch: Vec<([u32; 3], Box32)>,
     /// Scratch: unmoved faces (corners, box) near the fan.
     near_scratch: Vec<([u32; 3], Box32)>,
+    /// Scratch: the rim edges of the fan after the collapse (see [`fan_is_embedded`]).
+    rim_scratch: Vec<[DVec3; 2]>,
     collapses: usize,
     vetoes: VetoCounts,
     passes: usize,
@@ -412,6 +414,7 @@ impl<'m, F: FnMut(&Collapse)> Decimator<'m, F> {
             fan: Vec::new(),
             fan_scratch: Vec::new(),
             near_scratch: Vec::new(),
+            rim_scratch: Vec::new(),
             collapses: 0,
             vetoes: VetoCounts::default(),
             passes: 0,
@@ -589,9 +592,18 @@ impl<'m, F: FnMut(&Collapse)> Decimator<'m, F> {
                 }
             });
         }
+        // The fan's own pairs need no test when the fan is certainly embedded (the common case).
+        let rim = &mut self.rim_scratch;
+        rim.clear();
+        rim.extend(
+            self.fan
+                .iter()
+                .map(|c| [c[1], c[2]].map(|v| positions[v.index()])),
+        );
+        let test_fan_pairs = !fan_is_embedded(p, rim);
         let mut hit = false;
         'fan: for (i, &(tri, bx)) in fan.iter().enumerate() {
-            for &(other, other_box) in &fan[i + 1..] {
+            for &(other, other_box) in fan[i + 1..].iter().filter(|_| test_fan_pairs) {
                 if other_box.overlaps(&bx) && faces_intersect_filtered(positions, tri, other) {
                     hit = true;
                     break 'fan;
