@@ -169,6 +169,49 @@ pub(crate) fn faces_intersect_filtered(positions: &[DVec3], ta: [u32; 3], tb: [u
     faces_intersect(positions, ta, tb)
 }
 
+/// True if the closed fan of triangles `(apex, rim[i][0], rim[i][1])` certainly has no two faces
+/// that intersect in the sense of [`faces_intersect`] (faces meet only in the apex and, for
+/// neighbours, along their shared edge), so the pairwise tests can be skipped.
+///
+/// Precondition: the fan is the full star of a vertex of a closed 2-manifold (each rim vertex
+/// ends one face's rim edge and starts the next one's), with distinct rim vertices.
+///
+/// The proof, with every sign certified by [`certain_orient3d`] (the answer is `false` as soon as
+/// one is uncertain): project along the line from `apex` to `q = apex + Σ face normals`.
+/// 1. Every face projects to a non-degenerate triangle, all of one orientation, so each face is
+///    one-to-one onto its projection, a sector at the apex of angle in (0, π).
+/// 2. The rim is a closed chain of such sectors, so it winds around the apex a whole number
+///    `w ≥ 1` of times, and every ray from the apex (along no rim vertex) lies in exactly `w`
+///    sectors. The ray towards the centroid of the first face lies in exactly one: `w = 1`.
+/// 3. So the sectors tile the plane around the apex: two faces' projections meet only in the
+///    apex, or along the common edge of neighbours. A common point of the faces projects there
+///    and, the projection being one-to-one on each face, is the apex or on the common edge.
+pub(crate) fn fan_is_embedded(apex: DVec3, rim: &[[DVec3; 2]]) -> bool {
+    let normal: DVec3 = rim.iter().map(|[x, y]| (*x - apex).cross(*y - apex)).sum();
+    let q = apex + normal;
+    let Some(&[x0, y0]) = rim.first() else {
+        return false;
+    };
+    let ray = (apex + x0 + y0) / 3.0;
+    let Some(side) = certain_orient3d(apex, x0, y0, q) else {
+        return false;
+    };
+    let mut sectors_on_ray = 0;
+    for &[x, y] in rim {
+        if certain_orient3d(apex, x, y, q) != Some(side) {
+            return false;
+        }
+        let (Some(after_x), Some(before_y)) = (
+            certain_orient3d(apex, x, ray, q),
+            certain_orient3d(apex, ray, y, q),
+        ) else {
+            return false;
+        };
+        sectors_on_ray += usize::from(after_x == side && before_y == side);
+    }
+    sectors_on_ray == 1
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -225,6 +268,81 @@ mod tests {
             }
         }
         assert!(checked > 5000 && hits > 500, "{checked} pairs, {hits} hits");
+    }
+
+    /// A fan around the origin: `rim` points at the given angles (radians) and heights.
+    fn fan(angles: &[f64], heights: &[f64]) -> Vec<[DVec3; 2]> {
+        let at = |k: usize| {
+            let k = k % angles.len();
+            DVec3::new(angles[k].cos(), angles[k].sin(), heights[k])
+        };
+        (0..angles.len()).map(|k| [at(k), at(k + 1)]).collect()
+    }
+
+    #[test]
+    fn flat_and_gently_curved_fans_are_embedded_but_folded_or_doubly_wound_ones_are_not() {
+        let six: Vec<f64> = (0..6)
+            .map(|k| k as f64 * std::f64::consts::TAU / 6.0)
+            .collect();
+        assert!(fan_is_embedded(DVec3::ZERO, &fan(&six, &[0.0; 6])));
+        assert!(fan_is_embedded(
+            DVec3::ZERO,
+            &fan(&six, &[0.3, -0.2, 0.5, 0.1, -0.4, 0.2])
+        ));
+        // A rim point pulled across its neighbour: one face folds over.
+        let mut folded = six.clone();
+        folded[2] = six[0] - 0.3;
+        assert!(!fan_is_embedded(DVec3::ZERO, &fan(&folded, &[0.0; 6])));
+        // The rim goes around twice.
+        let twice: Vec<f64> = (0..7)
+            .map(|k| k as f64 * 2.0 * std::f64::consts::TAU / 7.0)
+            .collect();
+        assert!(!fan_is_embedded(DVec3::ZERO, &fan(&twice, &[0.0; 7])));
+        assert!(!fan_is_embedded(DVec3::ZERO, &[]));
+    }
+
+    /// Random fans (flat ones with exactly representable coordinates included): whenever the
+    /// fan is reported embedded, the exact test finds no intersecting pair.
+    #[test]
+    fn embedded_fans_have_no_intersecting_pair() {
+        let mut rng = ChaCha8Rng::seed_from_u64(3);
+        let mut embedded = 0;
+        for trial in 0..3000 {
+            let k = rng.random_range(3..9);
+            let mut angles: Vec<f64> = (0..k)
+                .map(|_| rng.random_range(0.0..std::f64::consts::TAU))
+                .collect();
+            angles.sort_by(f64::total_cmp);
+            if trial % 3 == 0 {
+                angles.swap(0, k / 2); // often folded
+            }
+            let heights: Vec<f64> = (0..k)
+                .map(|_| {
+                    if trial % 2 == 0 {
+                        0.0
+                    } else {
+                        rng.random_range(-1.5..1.5)
+                    }
+                })
+                .collect();
+            let rim = fan(&angles, &heights);
+            if !fan_is_embedded(DVec3::ZERO, &rim) {
+                continue;
+            }
+            embedded += 1;
+            let mut positions = vec![DVec3::ZERO];
+            positions.extend(rim.iter().map(|r| r[0]));
+            let face = |i: usize| [0, 1 + i as u32, 1 + ((i + 1) % k) as u32];
+            for i in 0..k {
+                for j in i + 1..k {
+                    assert!(
+                        !faces_intersect(&positions, face(i), face(j)),
+                        "{angles:?} {heights:?}"
+                    );
+                }
+            }
+        }
+        assert!(embedded > 500, "{embedded}");
     }
 
     #[test]

@@ -5,6 +5,12 @@
 //! Each face is listed in every cell its box overlaps; faces spanning more than
 //! [`MAX_CELLS_PER_FACE`] cells go to an always-scanned `oversized` list. Insert and remove are
 //! O(cells of the face); the caller rebuilds with a coarser cell when faces have grown.
+//!
+//! A query touches only the buckets of its cells: every entry carries the face's corners and its
+//! box (rounded outward to `f32`), so no per-face array is read, and a face listed in several
+//! cells is reported once because it is reported only from one cell (see [`FaceGrid::query`]),
+//! not through a per-face "seen" stamp. Those per-face reads were cache misses that made up most
+//! of the query time on large meshes.
 
 use roar_mesh::spatial::Aabb;
 
@@ -13,18 +19,11 @@ const MAX_CELLS_PER_FACE: i64 = 64;
 
 type Cell = [i32; 3];
 
-#[derive(Debug, Clone, Copy)]
-enum Slot {
-    Absent,
-    Cells { lo: Cell, hi: Cell },
-    Oversized,
-}
-
-/// A face listed in a bucket, with its box rounded outward to `f32` so that a query can reject
-/// most entries while scanning the bucket sequentially.
-#[derive(Debug, Clone, Copy)]
-struct Entry {
-    face: u32,
+/// A box with `f32` corners. Made from an [`Aabb`] by rounding outward ([`Box32::around`]), so it
+/// contains the original box: two such boxes overlap whenever the originals do, which makes them
+/// a safe filter in front of an exact test.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct Box32 {
     lo: [f32; 3],
     hi: [f32; 3],
 }
@@ -41,41 +40,69 @@ fn f32_up(x: f64) -> f32 {
     if (m as f64) < x { m.next_up() } else { m }
 }
 
-/// `b` rounded outward to `f32`.
-fn f32_box(b: &Aabb) -> ([f32; 3], [f32; 3]) {
-    (
-        [b.min.x, b.min.y, b.min.z].map(f32_down),
-        [b.max.x, b.max.y, b.max.z].map(f32_up),
-    )
+impl Box32 {
+    /// The smallest `f32` box containing `b` (NaN coordinates stay NaN and overlap nothing, as
+    /// with [`Aabb::overlaps`]).
+    pub(crate) fn around(b: &Aabb) -> Box32 {
+        Box32 {
+            lo: [b.min.x, b.min.y, b.min.z].map(f32_down),
+            hi: [b.max.x, b.max.y, b.max.z].map(f32_up),
+        }
+    }
+
+    /// The smallest box containing both (NaN-free inputs).
+    pub(crate) fn union(&self, o: &Box32) -> Box32 {
+        Box32 {
+            lo: [0, 1, 2].map(|k| self.lo[k].min(o.lo[k])),
+            hi: [0, 1, 2].map(|k| self.hi[k].max(o.hi[k])),
+        }
+    }
+
+    /// Whether the closed boxes share a point. (All six comparisons are evaluated, without
+    /// branches: the answer is unpredictable in a bucket scan.)
+    #[inline]
+    pub(crate) fn overlaps(&self, o: &Box32) -> bool {
+        (o.lo[0] <= self.hi[0])
+            & (self.lo[0] <= o.hi[0])
+            & (o.lo[1] <= self.hi[1])
+            & (self.lo[1] <= o.hi[1])
+            & (o.lo[2] <= self.hi[2])
+            & (self.lo[2] <= o.hi[2])
+    }
+
+    fn is_finite(&self) -> bool {
+        self.lo.iter().chain(&self.hi).all(|x| x.is_finite())
+    }
 }
 
-#[inline]
-fn overlaps_f32(lo: &[f32; 3], hi: &[f32; 3], e: &Entry) -> bool {
-    e.lo[0] <= hi[0]
-        && lo[0] <= e.hi[0]
-        && e.lo[1] <= hi[1]
-        && lo[1] <= e.hi[1]
-        && e.lo[2] <= hi[2]
-        && lo[2] <= e.hi[2]
+/// A face listed in a bucket, with its corners and rounded box as of its insertion.
+#[derive(Debug, Clone, Copy)]
+struct Entry {
+    face: u32,
+    corners: [u32; 3],
+    bx: Box32,
+}
+
+#[derive(Debug, Clone, Copy)]
+enum Slot {
+    Absent,
+    Cells { lo: Cell, hi: Cell },
+    Oversized,
 }
 
 /// Face ids (`u32`) bucketed by the grid cells their boxes overlap, with each face's box and
 /// corners as of its insertion.
 ///
 /// Cells are hashed into a power-of-two table of buckets (no map, no bounds needed); two cells
-/// sharing a bucket only add candidates, which the stored boxes filter out.
+/// sharing a bucket only add candidates, which the stored boxes filter out. A face is listed at
+/// most once per bucket, even when several of its cells share the bucket.
 #[derive(Debug)]
 pub(crate) struct FaceGrid {
     inv_cell: f64,
     buckets: Vec<Vec<Entry>>,
     mask: usize,
     slots: Vec<Slot>,
-    boxes: Vec<Aabb>,
-    corners: Vec<[u32; 3]>,
-    oversized: Vec<u32>,
-    /// Per-face query stamp, so a face listed in several cells is visited once per query.
-    seen: Vec<u32>,
-    query: u32,
+    oversized: Vec<Entry>,
 }
 
 /// The bucket of `cell` in a table of `mask + 1` buckets.
@@ -97,23 +124,24 @@ impl FaceGrid {
             buckets: vec![Vec::new(); n_buckets],
             mask: n_buckets - 1,
             slots: vec![Slot::Absent; capacity],
-            boxes: vec![Aabb::EMPTY; capacity],
-            corners: vec![[0; 3]; capacity],
             oversized: Vec::new(),
-            seen: vec![0; capacity],
-            query: 0,
         }
     }
 
-    fn cell_of(&self, x: f64) -> i32 {
-        // `as` saturates, so far-away or non-finite coordinates stay in range.
-        (x * self.inv_cell).floor() as i32
+    /// `floor(x / cell)`, saturated to `i32` (NaN gives 0), like `(x * inv_cell).floor() as i32`
+    /// but without a call to `floor`, which is not inlined on baseline x86-64.
+    #[inline]
+    fn cell_of(&self, x: f32) -> i32 {
+        let v = x as f64 * self.inv_cell;
+        let t = v as i32;
+        t.saturating_sub(i32::from(t as f64 > v))
     }
 
-    fn range(&self, b: &Aabb) -> (Cell, Cell) {
-        let lo = [b.min.x, b.min.y, b.min.z].map(|x| self.cell_of(x));
-        let hi = [b.max.x, b.max.y, b.max.z].map(|x| self.cell_of(x));
-        (lo, hi)
+    /// The cells of `b`: every cell is computed from the rounded box, so a face and a query
+    /// whose rounded boxes overlap have overlapping cell ranges (`cell_of` is monotone).
+    #[inline]
+    fn range(&self, b: &Box32) -> (Cell, Cell) {
+        (b.lo.map(|x| self.cell_of(x)), b.hi.map(|x| self.cell_of(x)))
     }
 
     fn count(lo: Cell, hi: Cell) -> i64 {
@@ -130,17 +158,15 @@ impl FaceGrid {
     /// Adds face `f` with corners `corners` and box `b` (removing it first if present).
     pub(crate) fn insert(&mut self, f: u32, corners: [u32; 3], b: &Aabb) {
         self.remove(f);
-        self.boxes[f as usize] = *b;
-        self.corners[f as usize] = corners;
-        let (lo, hi) = self.range(b);
-        let (flo, fhi) = f32_box(b);
+        let bx = Box32::around(b);
         let entry = Entry {
             face: f,
-            lo: flo,
-            hi: fhi,
+            corners,
+            bx,
         };
-        if !b.min.is_finite() || !b.max.is_finite() || Self::count(lo, hi) > MAX_CELLS_PER_FACE {
-            self.oversized.push(f);
+        let (lo, hi) = self.range(&bx);
+        if !bx.is_finite() || Self::count(lo, hi) > MAX_CELLS_PER_FACE {
+            self.oversized.push(entry);
             self.slots[f as usize] = Slot::Oversized;
             return;
         }
@@ -148,7 +174,11 @@ impl FaceGrid {
             for y in lo[1]..=hi[1] {
                 for z in lo[2]..=hi[2] {
                     let k = self.bucket([x, y, z]);
-                    self.buckets[k].push(entry);
+                    let list = &mut self.buckets[k];
+                    // This insert's own entries are the last ones pushed to a bucket.
+                    if list.last().is_none_or(|e| e.face != f) {
+                        list.push(entry);
+                    }
                 }
             }
         }
@@ -159,7 +189,7 @@ impl FaceGrid {
     pub(crate) fn remove(&mut self, f: u32) {
         match std::mem::replace(&mut self.slots[f as usize], Slot::Absent) {
             Slot::Absent => {}
-            Slot::Oversized => self.oversized.retain(|&g| g != f),
+            Slot::Oversized => self.oversized.retain(|e| e.face != f),
             Slot::Cells { lo, hi } => {
                 for x in lo[0]..=hi[0] {
                     for y in lo[1]..=hi[1] {
@@ -174,51 +204,47 @@ impl FaceGrid {
                 }
             }
         }
-        self.boxes[f as usize] = Aabb::EMPTY;
     }
 
-    /// Calls `visit(face, its box, its corners)` once for every face whose box overlaps `b`
-    /// (all faces sharing a bucket with a cell of `b`, and the oversized ones, are scanned).
-    pub(crate) fn query(&mut self, b: &Aabb, mut visit: impl FnMut(u32, &Aabb, [u32; 3])) {
-        self.query = self.query.wrapping_add(1);
-        if self.query == 0 {
-            self.seen.fill(0);
-            self.query = 1;
-        }
-        let stamp = self.query;
+    /// Calls `visit(face, its rounded box, its corners)` exactly once for every face whose
+    /// rounded box overlaps `b` (and for no other face).
+    ///
+    /// Each face is reported from one cell only: the lowest cell (per axis) shared by its cell
+    /// range and the query's, which lies in both ranges whenever the boxes overlap. A bucket is
+    /// scanned once per query cell mapping to it, and lists the face at most once.
+    pub(crate) fn query(&self, b: &Box32, mut visit: impl FnMut(u32, &Box32, [u32; 3])) {
         let (lo, hi) = self.range(b);
-        let (qlo, qhi) = f32_box(b);
-        let (seen, boxes, corners) = (&mut self.seen, &self.boxes, &self.corners);
-        let mut take = |f: u32| {
-            if seen[f as usize] != stamp {
-                seen[f as usize] = stamp;
-                let fb = &boxes[f as usize];
-                if fb.overlaps(b) {
-                    visit(f, fb, corners[f as usize]);
+        if !b.is_finite() || Self::count(lo, hi) > self.buckets.len() as i64 {
+            // Every face is listed in the bucket of its lowest cell.
+            for (k, list) in self.buckets.iter().enumerate() {
+                for e in list {
+                    if b.overlaps(&e.bx) && self.bucket(self.range(&e.bx).0) == k {
+                        visit(e.face, &e.bx, e.corners);
+                    }
                 }
-            }
-        };
-        if !b.min.is_finite()
-            || !b.max.is_finite()
-            || Self::count(lo, hi) > self.buckets.len() as i64
-        {
-            for list in &self.buckets {
-                list.iter().for_each(|e| take(e.face));
             }
         } else {
             for x in lo[0]..=hi[0] {
                 for y in lo[1]..=hi[1] {
                     for z in lo[2]..=hi[2] {
-                        for e in &self.buckets[bucket_of(self.mask, [x, y, z])] {
-                            if overlaps_f32(&qlo, &qhi, e) {
-                                take(e.face);
+                        for e in &self.buckets[self.bucket([x, y, z])] {
+                            if b.overlaps(&e.bx) {
+                                let first = self.range(&e.bx).0;
+                                let own = [0, 1, 2].map(|k| first[k].max(lo[k]));
+                                if own == [x, y, z] {
+                                    visit(e.face, &e.bx, e.corners);
+                                }
                             }
                         }
                     }
                 }
             }
         }
-        self.oversized.iter().for_each(|&f| take(f));
+        for e in &self.oversized {
+            if b.overlaps(&e.bx) {
+                visit(e.face, &e.bx, e.corners);
+            }
+        }
     }
 }
 
@@ -234,6 +260,13 @@ mod tests {
         }
     }
 
+    fn found(g: &FaceGrid, b: &Aabb) -> Vec<u32> {
+        let mut found = Vec::new();
+        g.query(&Box32::around(b), |f, _, _| found.push(f));
+        found.sort();
+        found
+    }
+
     #[test]
     fn query_finds_overlapping_faces_once_and_forgets_removed_ones() {
         let mut g = FaceGrid::new(1.0, 4, 4);
@@ -241,14 +274,35 @@ mod tests {
         g.insert(1, [0, 1, 2], &boxed(0.5, 2.5));
         g.insert(2, [0, 1, 2], &boxed(5.0, 5.5));
         g.insert(3, [0, 1, 2], &boxed(-100.0, 100.0)); // oversized
-        let mut found = Vec::new();
-        g.query(&boxed(0.0, 1.5), |f, _, _| found.push(f));
-        found.sort();
-        assert_eq!(found, vec![0, 1, 3]);
+        assert_eq!(found(&g, &boxed(0.0, 1.5)), vec![0, 1, 3]);
+        // A query box spanning more cells than there are buckets scans every bucket.
+        assert_eq!(found(&g, &boxed(-50.0, 50.0)), vec![0, 1, 2, 3]);
         g.remove(1);
         g.remove(3);
-        found.clear();
-        g.query(&boxed(0.0, 1.5), |f, _, _| found.push(f));
-        assert_eq!(found, vec![0]);
+        assert_eq!(found(&g, &boxed(0.0, 1.5)), vec![0]);
+    }
+
+    #[test]
+    fn query_reports_each_face_once_even_when_its_cells_share_buckets() {
+        // 64 buckets and faces spanning up to 4³ cells: many cells of one face share a bucket.
+        let mut g = FaceGrid::new(0.25, 40, 1);
+        let faces: Vec<Aabb> = (0..40)
+            .map(|i| {
+                let a = 0.37 * i as f64 - 3.0;
+                Aabb {
+                    min: DVec3::new(a, -a, 0.5 * a),
+                    max: DVec3::new(a + 0.9, -a + 0.6, 0.5 * a + 0.8),
+                }
+            })
+            .collect();
+        for (f, b) in faces.iter().enumerate() {
+            g.insert(f as u32, [0, 1, 2], b);
+        }
+        for q in [boxed(-1.0, 1.0), boxed(-3.0, 0.0), boxed(0.3, 0.4)] {
+            let expected: Vec<u32> = (0..40)
+                .filter(|&f| Box32::around(&faces[f as usize]).overlaps(&Box32::around(&q)))
+                .collect();
+            assert_eq!(found(&g, &q), expected);
+        }
     }
 }

@@ -29,9 +29,9 @@ mod grid;
 mod heap;
 mod quadric;
 
-use crate::intersect::faces_intersect_filtered;
+use crate::intersect::{faces_intersect_filtered, fan_is_embedded};
 use glam::DVec3;
-use grid::FaceGrid;
+use grid::{Box32, FaceGrid};
 use heap::EdgeHeap;
 use quadric::{Quadric, placement};
 use roar_mesh::spatial::Aabb;
@@ -367,13 +367,12 @@ struct Decimator<'m, F: FnMut(&Collapse)> {
     grid_faces: usize,
     /// Scratch: the corners (before the collapse) of the fan of the collapse being checked.
     fan: Vec<[VertexId; 3]>,
-    /// Scratch: per-face stamp marking the fan and the two removed faces of the current check.
-    in_fan: Vec<u32>,
-    stamp: u32,
     /// Scratch: the fan's faces after the collapse (relabelled corners) and their boxes.
-    fan_scratch: Vec<([u32; 3], Aabb)>,
+    fan_scratch: Vec<([u32; 3], Box32)>,
     /// Scratch: unmoved faces (corners, box) near the fan.
-    near_scratch: Vec<([u32; 3], Aabb)>,
+    near_scratch: Vec<([u32; 3], Box32)>,
+    /// Scratch: the rim edges of the fan after the collapse (see [`fan_is_embedded`]).
+    rim_scratch: Vec<[DVec3; 2]>,
     collapses: usize,
     vetoes: VetoCounts,
     passes: usize,
@@ -406,7 +405,6 @@ impl<'m, F: FnMut(&Collapse)> Decimator<'m, F> {
         let mut d = Decimator {
             targets: vec![DVec3::ZERO; mesh.edge_capacity()],
             heap: EdgeHeap::new(mesh.edge_capacity()),
-            in_fan: vec![0; mesh.face_capacity()],
             mesh,
             options,
             on_collapse,
@@ -414,9 +412,9 @@ impl<'m, F: FnMut(&Collapse)> Decimator<'m, F> {
             grid: None,
             grid_faces: 0,
             fan: Vec::new(),
-            stamp: 0,
             fan_scratch: Vec::new(),
             near_scratch: Vec::new(),
+            rim_scratch: Vec::new(),
             collapses: 0,
             vetoes: VetoCounts::default(),
             passes: 0,
@@ -493,21 +491,11 @@ impl<'m, F: FnMut(&Collapse)> Decimator<'m, F> {
     }
 
     /// Fills `self.fan` with the faces that survive a collapse of `h` and change shape (all
-    /// faces around both endpoints except the two on the edge), with their current corners,
-    /// and stamps them and the two removed faces in `in_fan`.
+    /// faces around both endpoints except the two on the edge), with their current corners.
     fn collect_fan(&mut self, h: HalfedgeId) {
         let mesh = &*self.mesh;
         let (a, b) = (mesh.tail(h), mesh.head(h));
-        self.stamp = self.stamp.wrapping_add(1);
-        if self.stamp == 0 {
-            self.in_fan.fill(0);
-            self.stamp = 1;
-        }
-        let stamp = self.stamp;
         let gone = [mesh.face(h), mesh.face(h.twin())];
-        for f in gone {
-            self.in_fan[f.index()] = stamp;
-        }
         self.fan.clear();
         for v in [a, b] {
             for o in mesh.outgoing(v) {
@@ -517,7 +505,6 @@ impl<'m, F: FnMut(&Collapse)> Decimator<'m, F> {
                 }
                 // Outgoing `o: v → x` lies in the counter-clockwise face (v, x, head(next(o))).
                 let corners = [v, mesh.head(o), mesh.head(mesh.next(o))];
-                self.in_fan[face.index()] = stamp;
                 self.fan.push(corners);
             }
         }
@@ -577,30 +564,46 @@ impl<'m, F: FnMut(&Collapse)> Decimator<'m, F> {
         self.mesh.set_position(a, p);
         self.mesh.set_position(b, p);
         let mesh = &*self.mesh;
-        let grid = self.grid.as_mut().expect("grid exists when checking");
+        let grid = self.grid.as_ref().expect("grid exists when checking");
         let positions = mesh.positions();
         let relabel = |c: [VertexId; 3]| c.map(|v| if v == a { b.raw() } else { v.raw() });
-        let (in_fan, stamp) = (&self.in_fan, self.stamp);
-        // The new fan faces with their boxes, and the box of them all.
+        // The faces of the star of `a` or `b` (the fan and the two removed faces) are exactly
+        // the faces with `a` or `b` as a corner; the grid stores every face's current corners.
+        let (a_raw, b_raw) = (a.raw(), b.raw());
+        let in_star = |corners: [u32; 3]| corners.contains(&a_raw) || corners.contains(&b_raw);
+        // The new fan faces with their boxes, and the box of them all (rounded outward to
+        // `f32`, like the grid's: a box test only filters pairs for the exact test, so a
+        // slightly larger box never changes the answer).
         let fan = &mut self.fan_scratch;
         fan.clear();
-        let mut all = Aabb::EMPTY;
+        let mut all: Option<Box32> = None;
         for &c in &self.fan {
-            let bx = Aabb::from_triangle(c.map(|v| positions[v.index()]));
-            all = all.union(&bx);
+            let bx = Box32::around(&Aabb::from_triangle(c.map(|v| positions[v.index()])));
+            all = Some(all.map_or(bx, |a| a.union(&bx)));
             fan.push((relabel(c), bx));
         }
         // One grid query for the whole fan: the unmoved faces near it.
         let near = &mut self.near_scratch;
         near.clear();
-        grid.query(&all, |g, g_box, corners| {
-            if in_fan[g as usize] != stamp {
-                near.push((corners, *g_box));
-            }
-        });
+        if let Some(all) = all {
+            grid.query(&all, |_, g_box, corners| {
+                if !in_star(corners) {
+                    near.push((corners, *g_box));
+                }
+            });
+        }
+        // The fan's own pairs need no test when the fan is certainly embedded (the common case).
+        let rim = &mut self.rim_scratch;
+        rim.clear();
+        rim.extend(
+            self.fan
+                .iter()
+                .map(|c| [c[1], c[2]].map(|v| positions[v.index()])),
+        );
+        let test_fan_pairs = !fan_is_embedded(p, rim);
         let mut hit = false;
         'fan: for (i, &(tri, bx)) in fan.iter().enumerate() {
-            for &(other, other_box) in &fan[i + 1..] {
+            for &(other, other_box) in fan[i + 1..].iter().filter(|_| test_fan_pairs) {
                 if other_box.overlaps(&bx) && faces_intersect_filtered(positions, tri, other) {
                     hit = true;
                     break 'fan;
