@@ -9,7 +9,9 @@
 //!   tombstones and `optimizer.len() == mesh.vertex_capacity()`;
 //! - geometric vetoes are counted by reason in [`BlockStats::rejected`].
 
+use crate::guard::IntersectionGuard;
 use crate::optim::Optimizer;
+use crate::qslim::EdgeCost;
 use roar_mesh::Mesh;
 use roar_mesh::spatial::Projector;
 use serde::Serialize;
@@ -114,4 +116,43 @@ pub fn compact_with_optimizer(mesh: &mut Mesh, optimizer: &mut Optimizer) {
     // Live vertices all map somewhere; if the mesh's last slots were dead the optimizer may be
     // shorter than the new capacity only when nothing maps there, which cannot happen.
     sync_optimizer_len(mesh, optimizer);
+}
+
+/// Applies the collapse `c` chosen by a block: the mesh merges `c.halfedge`'s tail into `c.keep`
+/// (which keeps its position), and the optimizer row of `c.keep` survives. With a `guard`, a
+/// collapse that would make a face intersect another one is skipped and counted as
+/// `rejected["intersection"]`; a collapse the link condition refuses (an earlier collapse of the
+/// block changed the neighbourhood) as `rejected["link"]`. Returns whether it was applied.
+pub fn apply_collapse(
+    mesh: &mut Mesh,
+    optimizer: &mut Optimizer,
+    c: &EdgeCost,
+    guard: Option<&mut IntersectionGuard>,
+    stats: &mut BlockStats,
+) -> bool {
+    if mesh.can_collapse(c.halfedge).is_err() {
+        stats.reject("link", 1);
+        return false;
+    }
+    let mut guard = guard;
+    if let Some(guard) = guard.as_deref_mut() {
+        let p = mesh.position(c.keep);
+        if guard.collapse_intersects(mesh, c.halfedge, p) {
+            stats.reject("intersection", 1);
+            return false;
+        }
+    }
+    let out = mesh
+        .collapse(c.halfedge)
+        .expect("can_collapse passed just before (invariant)");
+    optimizer
+        .on_collapse(out.survivor.raw(), c.keep.raw())
+        .expect("optimizer rows cover every vertex slot (invariant)");
+    if let Some(guard) = guard {
+        for f in out.removed_faces {
+            guard.mark(f);
+        }
+        guard.mark_around(mesh, out.survivor);
+    }
+    true
 }

@@ -12,9 +12,12 @@
 //! 4. Independent selection (§3.11), collapse (the survivor keeps the chosen endpoint's position
 //!    and optimizer row), compact, then flips.
 
-use crate::block::{Block, BlockContext, BlockStats, compact_with_optimizer, sync_optimizer_len};
+use crate::block::{
+    Block, BlockContext, BlockStats, apply_collapse, compact_with_optimizer, sync_optimizer_len,
+};
 use crate::flips::{FlipOptions, flip_edges};
 use crate::geometry::Geometry;
+use crate::guard::IntersectionGuard;
 use crate::optim::Optimizer;
 use crate::qslim::{EdgeCost, QSlimOptions, ValidityOptions, edge_cost, vertex_quadrics};
 use crate::select::{SelectOptions, select_independent_edges};
@@ -39,6 +42,10 @@ pub struct FaceCollapseOptions {
     pub select: SelectOptions,
     /// Edge flips run after the collapses (§3.6 step 7); `None` skips them.
     pub flips: Option<FlipOptions>,
+    /// Skip collapses that would make a face intersect another one
+    /// ([`IntersectionGuard`], `rejected["intersection"]`). Default off (the paper's block);
+    /// the pipeline switches it on. [INF]
+    pub guard_intersections: bool,
 }
 
 impl Default for FaceCollapseOptions {
@@ -50,6 +57,7 @@ impl Default for FaceCollapseOptions {
             qslim: QSlimOptions::default(),
             select: SelectOptions::default(),
             flips: Some(FlipOptions::default()),
+            guard_intersections: false,
         }
     }
 }
@@ -99,7 +107,8 @@ pub fn folds_onto_a_neighbour(mesh: &Mesh, geometry: &Geometry, f: roar_mesh::Fa
 ///
 /// Stats: `candidates` = candidate edges (edges of flagged faces); `accepted` = collapses;
 /// `rejected`: `"flip"` / `"quality"` (no valid placement), `"link"` (local maximum refused by
-/// the link condition), `"not_selected"` (valid but lost the independent selection);
+/// the link condition), `"not_selected"` (valid but lost the independent selection),
+/// `"intersection"` (vetoed by the guard, if on);
 /// `counters["flagged_faces"]`; `sub` = the flip stats.
 pub fn face_collapse(
     mesh: &mut Mesh,
@@ -141,17 +150,13 @@ pub fn face_collapse(
     let selection = select_independent_edges(mesh, &priority, &options.select);
     stats.reject("link", selection.link_rejected);
     let valid = placement.iter().filter(|p| p.is_some()).count();
+    let mut guard = (options.guard_intersections && !selection.edges.is_empty())
+        .then(|| IntersectionGuard::new(mesh));
     for &e in &selection.edges {
         let c =
             placement[e.index()].expect("selected edges have positive priority, so a placement");
-        match mesh.collapse(c.halfedge) {
-            Ok(out) => {
-                optimizer
-                    .on_collapse(out.survivor.raw(), c.keep.raw())
-                    .expect("optimizer rows cover every vertex slot (invariant)");
-                stats.accepted += 1;
-            }
-            Err(_) => stats.reject("link", 1),
+        if apply_collapse(mesh, optimizer, &c, guard.as_mut(), &mut stats) {
+            stats.accepted += 1;
         }
     }
     stats.reject(

@@ -17,6 +17,7 @@
 
 use crate::block::{Block, BlockContext, BlockStats};
 use crate::geometry::triangle_normal;
+use crate::guard::IntersectionGuard;
 use crate::optim::Optimizer;
 use roar_mesh::{EdgeId, Mesh};
 
@@ -32,6 +33,10 @@ pub struct FlipOptions {
     pub min_abs_flatness: Option<f64>,
     /// Tolerance of the normal check `N_old · n_new > −tol`. Default 1e-8 (§3.7 step 2).
     pub normal_tolerance: f64,
+    /// Skip flips whose new faces would intersect another face ([`IntersectionGuard`],
+    /// `rejected["intersection"]`). Default off (the paper's block); the pipeline switches it
+    /// on. [INF]
+    pub guard_intersections: bool,
 }
 
 impl Default for FlipOptions {
@@ -41,6 +46,7 @@ impl Default for FlipOptions {
             max_candidates_per_round: 2000,
             min_abs_flatness: Some(0.95),
             normal_tolerance: 1e-8,
+            guard_intersections: false,
         }
     }
 }
@@ -51,7 +57,7 @@ impl Default for FlipOptions {
 /// Stats (summed over rounds): `candidates` = edges with positive gain looked at;
 /// `accepted` = flips; `rejected`: `"normal"`, `"dihedral"`, `"topology"` (duplicate edge or
 /// valence 3), `"overlap"` (lost to a better neighbouring flip), `"cap"` (beyond the per-round
-/// cap).
+/// cap), `"intersection"` (vetoed by the guard, if on; the edge leaves the pool).
 pub fn flip_edges(mesh: &mut Mesh, options: &FlipOptions) -> BlockStats {
     let mut stats = BlockStats::new("edge_flips");
     let ne = mesh.edge_capacity();
@@ -60,6 +66,8 @@ pub fn flip_edges(mesh: &mut Mesh, options: &FlipOptions) -> BlockStats {
     let mut valence = vec![0u32; nv];
     let mut best = vec![0u64; nv];
     let mut cands: Vec<(EdgeId, u64, [usize; 4])> = Vec::new();
+    // Built at the first flip that passes the other tests, so calls without one cost nothing.
+    let mut guard: Option<IntersectionGuard> = None;
     for _ in 0..options.max_rounds {
         valence.iter_mut().for_each(|x| *x = 0);
         for h in mesh.halfedges() {
@@ -121,14 +129,25 @@ pub fn flip_edges(mesh: &mut Mesh, options: &FlipOptions) -> BlockStats {
         }
         let mut n_flipped = 0;
         for &(e, key, vs) in &cands {
-            if vs.iter().all(|&v| best[v] == key) {
-                mesh.flip(e)
-                    .expect("flip candidates are disjoint and passed can_flip (invariant)");
-                flipped[e.index()] = true;
-                n_flipped += 1;
-            } else {
+            if !vs.iter().all(|&v| best[v] == key) {
                 stats.reject("overlap", 1);
+                continue;
             }
+            if options.guard_intersections {
+                let guard = guard.get_or_insert_with(|| IntersectionGuard::new(mesh));
+                if guard.flip_intersects(mesh, e) {
+                    stats.reject("intersection", 1);
+                    flipped[e.index()] = true;
+                    continue;
+                }
+                let h = e.halfedge();
+                guard.mark(mesh.face(h));
+                guard.mark(mesh.face(h.twin()));
+            }
+            mesh.flip(e)
+                .expect("flip candidates are disjoint and passed can_flip (invariant)");
+            flipped[e.index()] = true;
+            n_flipped += 1;
         }
         for &(_, _, vs) in &cands {
             for v in vs {

@@ -8,6 +8,7 @@ pub mod block;
 pub mod collapse_block;
 pub mod flips;
 pub mod geometry;
+pub mod guard;
 pub mod init;
 mod intersect;
 pub mod optim;

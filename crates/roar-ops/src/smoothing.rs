@@ -10,6 +10,8 @@
 use crate::block::{Block, BlockContext, BlockStats};
 use crate::geometry::Geometry;
 use crate::optim::Optimizer;
+use crate::untangle::{LimiterOptions, limit_steps};
+use roar_mesh::spatial::TriangleBvh;
 use roar_mesh::{DVec3, Mesh};
 
 /// Options of [`tangential_smoothing`] (spec §3.9).
@@ -18,12 +20,17 @@ pub struct SmoothingOptions {
     /// Vertices with normal magnitude μ_v below this stay put (creases, spikes, folds).
     /// Default 0.98 ([SUP], §3.9).
     pub min_normal_magnitude: f64,
+    /// Shorten or cancel moves that would make faces intersect ([`limit_steps`], counted in
+    /// `counters["shortened"]`, `counters["cancelled"]`). Default off (the paper's block); the
+    /// pipeline switches it on. [INF]
+    pub guard_intersections: bool,
 }
 
 impl Default for SmoothingOptions {
     fn default() -> Self {
         Self {
             min_normal_magnitude: 0.98,
+            guard_intersections: false,
         }
     }
 }
@@ -58,11 +65,30 @@ pub fn tangential_smoothing(mesh: &mut Mesh, options: &SmoothingOptions) -> Bloc
         let tangential = d - n * n.dot(d);
         moves.push((v, p - tangential));
     }
+    let before = options
+        .guard_intersections
+        .then(|| mesh.positions().to_vec());
     for &(v, p) in &moves {
         if p.is_finite() {
             mesh.set_position(v, p);
             stats.accepted += 1;
         }
+    }
+    if let Some(before) = before {
+        let triangles: Vec<[u32; 3]> = mesh
+            .faces()
+            .map(|f| mesh.face_vertices(f).map(|v| v.raw()))
+            .collect();
+        let bvh = TriangleBvh::build(&before, &triangles);
+        let limited = limit_steps(
+            &before,
+            mesh.positions_mut(),
+            &triangles,
+            &bvh,
+            &LimiterOptions::default(),
+        );
+        stats.count("shortened", limited.shortened);
+        stats.count("cancelled", limited.cancelled);
     }
     stats
 }

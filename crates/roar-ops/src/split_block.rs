@@ -15,8 +15,11 @@
 //! 4. Pairing and budget (§3.8 steps 6–7, note 8), then collapses, then 1→3 centroid splits
 //!    (the new vertex gets the mean optimizer row), then compaction.
 
-use crate::block::{Block, BlockContext, BlockStats, compact_with_optimizer, sync_optimizer_len};
+use crate::block::{
+    Block, BlockContext, BlockStats, apply_collapse, compact_with_optimizer, sync_optimizer_len,
+};
 use crate::geometry::Geometry;
+use crate::guard::IntersectionGuard;
 use crate::optim::Optimizer;
 use crate::qslim::{
     EdgeCost, QSlimOptions, Quadric, ValidityOptions, edge_cost, edge_cost_lower_bound,
@@ -77,6 +80,11 @@ pub struct FaceSplitOptions {
     /// the `independent_edges`, `link` and, under budget, `swaps` stats then count only among
     /// those edges). `false` computes every edge, the reference for tests. Default true.
     pub prune_edge_costs: bool,
+    /// Skip budget collapses that would make a face intersect another one
+    /// ([`IntersectionGuard`], `rejected["intersection"]`; the swap's split is dropped with it).
+    /// The centroid splits move no geometry and need no guard. Default off (the paper's block);
+    /// the pipeline switches it on. [INF]
+    pub guard_intersections: bool,
 }
 
 impl Default for FaceSplitOptions {
@@ -95,6 +103,7 @@ impl Default for FaceSplitOptions {
             select: SelectOptions::default(),
             seed: 0,
             prune_edge_costs: true,
+            guard_intersections: false,
         }
     }
 }
@@ -400,20 +409,22 @@ pub fn face_split(
 
     // 8. Apply: collapses, then centroid splits.
     let mut collapsed = 0;
-    for e in to_collapse {
+    let mut paired_missing = 0;
+    let mut guard = (options.guard_intersections && !to_collapse.is_empty())
+        .then(|| IntersectionGuard::new(mesh));
+    for (i, e) in to_collapse.into_iter().enumerate() {
         let c = costs
             .placement(e)
             .expect("selected edges have finite cost, so a placement");
-        match mesh.collapse(c.halfedge) {
-            Ok(out) => {
-                optimizer
-                    .on_collapse(out.survivor.raw(), c.keep.raw())
-                    .expect("optimizer rows cover every vertex slot (invariant)");
-                collapsed += 1;
-            }
-            Err(_) => stats.reject("link", 1),
+        if apply_collapse(mesh, optimizer, &c, guard.as_mut(), &mut stats) {
+            collapsed += 1;
+        } else if i < n_paired {
+            paired_missing += 1;
         }
     }
+    // A swap whose collapse did not happen gives up its split too, so the block never ends
+    // above the budget it would have kept.
+    let n_split = n_split.saturating_sub(paired_missing);
     for &f in &ranked[..n_split] {
         if !mesh.is_face_alive(f) {
             stats.reject("removed_face", 1);

@@ -1,0 +1,102 @@
+//! Which blocks of the loop create self-intersections: runs the pipeline on a mesh file with
+//! every default block wrapped in a counter of intersecting faces before and after it, and
+//! prints, per block, how often it raised the count and by how much in total.
+//! `cargo run --release -p roar-cli --example block_intersections -- FILE [FACES] [RESOLUTION]`.
+//! Diagnostic only: the exact all-pairs check after every block makes the run much slower.
+
+use roar_cli::pipeline::{ReconstructConfig, Reconstruction, ScheduledBlock};
+use roar_mesh::Mesh;
+use roar_mesh::spatial::self_intersecting_faces;
+use roar_ops::block::{Block, BlockContext, BlockStats};
+use roar_ops::optim::Optimizer;
+use std::cell::RefCell;
+use std::collections::BTreeMap;
+use std::path::Path;
+use std::rc::Rc;
+
+/// Per block name: (times it raised the count, faces added); plus the last count seen, to
+/// attribute rises between blocks to the optimizer step.
+#[derive(Default)]
+struct Counts {
+    by_block: BTreeMap<&'static str, (usize, usize)>,
+    last: usize,
+}
+
+type Tally = Rc<RefCell<Counts>>;
+
+fn raise(counts: &mut Counts, name: &'static str, from: usize, to: usize) {
+    if to > from {
+        let entry = counts.by_block.entry(name).or_default();
+        entry.0 += 1;
+        entry.1 += to - from;
+    }
+}
+
+struct Counted {
+    inner: Box<dyn Block>,
+    tally: Tally,
+}
+
+fn intersecting(mesh: &Mesh) -> usize {
+    let (p, t) = mesh.to_triangles();
+    self_intersecting_faces(&p, &t)
+        .iter()
+        .filter(|&&b| b)
+        .count()
+}
+
+impl Block for Counted {
+    fn name(&self) -> &'static str {
+        self.inner.name()
+    }
+
+    fn apply(
+        &mut self,
+        mesh: &mut Mesh,
+        optimizer: &mut Optimizer,
+        ctx: &BlockContext,
+    ) -> BlockStats {
+        let before = intersecting(mesh);
+        let stats = self.inner.apply(mesh, optimizer, ctx);
+        let after = intersecting(mesh);
+        let mut counts = self.tally.borrow_mut();
+        let last = counts.last;
+        raise(&mut counts, "optimizer step (with limiter)", last, before);
+        raise(&mut counts, self.inner.name(), before, after);
+        counts.last = after;
+        stats
+    }
+}
+
+fn main() {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let soup = roar_io::read_mesh(Path::new(&args[0])).expect("readable mesh");
+    let config = ReconstructConfig {
+        faces: args.get(1).map_or(1000, |s| s.parse().unwrap()),
+        init_resolution: args.get(2).map_or(128, |s| s.parse().unwrap()),
+        ..ReconstructConfig::default()
+    };
+    let tally: Tally = Rc::default();
+    let mut reconstruction = Reconstruction::new(config);
+    let blocks = std::mem::take(&mut reconstruction.blocks);
+    reconstruction.blocks = blocks
+        .into_iter()
+        .map(|s| ScheduledBlock {
+            block: Box::new(Counted {
+                inner: s.block,
+                tally: tally.clone(),
+            }),
+            ..s
+        })
+        .collect();
+    let out = reconstruction
+        .run(&soup.positions, &soup.triangles, &mut |_| {})
+        .expect("reconstruction");
+    println!(
+        "unresolved after loop {}, finished from checkpoint {:?}",
+        out.stats.unresolved_after_loop, out.stats.finished_from_checkpoint
+    );
+    for (name, (times, faces)) in tally.borrow().by_block.iter() {
+        println!("{name}: raised the count {times} times, by {faces} faces in total");
+    }
+}
