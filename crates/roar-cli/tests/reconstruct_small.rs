@@ -37,6 +37,7 @@ fn run_with(
 ) -> (Vec<glam::DVec3>, Vec<[u32; 3]>, RunStats) {
     let soup = roar_cli::example::chair_soup();
     let config_iterations = config.iterations;
+    let (polish_iterations, faces) = (config.polish_iterations, config.faces);
     let mut stages = Vec::new();
     let mut reconstruction = Reconstruction::new(config);
     reconstruction.blocks.extend(extra);
@@ -56,6 +57,9 @@ fn run_with(
         let sum: f64 = record.terms.values().sum();
         assert!((sum - record.loss).abs() <= 1e-12 * record.loss.abs().max(1.0));
     }
+    // The polish after the final QEM ran at exactly the budget.
+    assert_eq!(out.stats.polish_history.len(), polish_iterations);
+    assert!(out.stats.polish_history.iter().all(|r| r.faces == faces));
     (out.positions, out.triangles, out.stats)
 }
 

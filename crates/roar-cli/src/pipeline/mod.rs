@@ -28,10 +28,11 @@ use roar_mesh::spatial::{TriangleBvh, self_intersecting_faces};
 use roar_mesh::{EdgeId, Mesh};
 use roar_ops::block::{Block, BlockContext, BlockStats};
 use roar_ops::collapse_block::{FaceCollapse, FaceCollapseOptions};
+use roar_ops::flips::FlipOptions;
 use roar_ops::init::{InitError, InitOptions, InitialMeshOptions};
 use roar_ops::optim::{Optimizer, OptimizerOptions};
 use roar_ops::qem::{DecimateError, DecimateOptions, DecimateStats, decimate};
-use roar_ops::smoothing::TangentialSmoothing;
+use roar_ops::smoothing::{SmoothingOptions, TangentialSmoothing};
 use roar_ops::split_block::{FaceSplit, FaceSplitOptions, SplitThreshold};
 use roar_ops::untangle::{LimiterOptions, UntangleOptions, UntangleStats, limit_steps, untangle};
 use serde::Serialize;
@@ -146,6 +147,10 @@ pub struct RunStats {
     pub untangle_rounds: usize,
     /// Collapses of the final QEM.
     pub final_collapses: usize,
+    /// Loss, terms and faces at every polish iteration (after the final QEM).
+    pub polish_history: Vec<IterationRecord>,
+    /// Whether the polished mesh was kept (false: it intersected itself, or no polish ran).
+    pub polish_kept: bool,
 }
 
 /// One iteration of the optimize stage, as the report lists it.
@@ -259,49 +264,27 @@ impl Reconstruction {
                 ..KnnOptions::default()
             },
         )?;
-        let mut optimizer = Optimizer::new(
-            mesh.vertex_capacity(),
-            OptimizerOptions {
-                lr: config.learning_rate,
-                laplacian_weight: config.laplacian_weight,
-                ..OptimizerOptions::default()
-            },
-        )
-        .map_err(|e| PipelineError::Config(e.to_string()))?;
+        let mut optimizer = new_optimizer(&mesh, &config)?;
         // The init at the working budget is intersection-free (init and QEM promise it).
         let mut checkpoint = (0, mesh.clone());
         clock.lap("loop_setup");
 
         for iteration in 0..config.iterations {
-            let triangles = compact_triangles(&mut mesh, &mut optimizer);
-            let (value, gradient) = loss.value_and_grad(mesh.positions(), &triangles)?;
+            let record = move_vertices(
+                &mut mesh,
+                &mut optimizer,
+                loss.as_mut(),
+                &config,
+                &mut stats,
+                &mut clock,
+                "loop",
+            )?;
+            let value = record.loss;
             if iteration == 0 {
                 stats.loss_first = value;
             }
             stats.loss_last = value;
-            stats.history.push(IterationRecord {
-                loss: value,
-                terms: loss.last_terms().into_iter().collect(),
-                faces: mesh.n_faces(),
-            });
-            clock.lap("loop_loss");
-            let before = config.step_limiter.then(|| mesh.positions().to_vec());
-            optimizer
-                .step(mesh.positions_mut(), &triangles, &gradient)
-                .map_err(|e| PipelineError::Internal(e.to_string()))?;
-            clock.lap("loop_step");
-            if let Some(before) = before {
-                let bvh = TriangleBvh::build(&before, &triangles);
-                let limited = limit_steps(
-                    &before,
-                    mesh.positions_mut(),
-                    &triangles,
-                    &bvh,
-                    &LimiterOptions::default(),
-                );
-                stats.steps_shortened += limited.shortened + limited.cancelled;
-                clock.lap("loop_step_limiter");
-            }
+            stats.history.push(record);
             let context = BlockContext {
                 iteration,
                 face_budget: budget,
@@ -328,7 +311,6 @@ impl Reconstruction {
             report("optimize", iteration, value, mesh.n_faces());
         }
         stats.loop_faces = mesh.n_faces();
-        drop(loss);
 
         report("finish", config.iterations, stats.loss_last, mesh.n_faces());
         let mut unresolved = fill_and_untangle(&mut mesh, &config, &mut stats);
@@ -353,6 +335,12 @@ impl Reconstruction {
         let decimated = final_decimation(&mut mesh, &config)?;
         stats.final_collapses = decimated.collapses;
         clock.lap("final_qem");
+
+        if config.polish_iterations > 0 {
+            report("polish", config.iterations, stats.loss_last, mesh.n_faces());
+            mesh = polish(mesh, loss.as_mut(), &config, &mut stats, &mut clock)?;
+        }
+        drop(loss);
 
         let (mut out_positions, out_triangles) = mesh.to_triangles();
         target.normalization.invert_all(&mut out_positions);
@@ -402,6 +390,11 @@ pub fn default_blocks(config: &ReconstructConfig) -> Vec<ScheduledBlock> {
                     fold_slack: config.collapse_fold_slack,
                     min_normal_size: (config.collapse_min_normal_size > 0.0)
                         .then_some(config.collapse_min_normal_size),
+                    flips: Some(FlipOptions {
+                        guard_intersections: config.guard_intersections,
+                        ..FlipOptions::default()
+                    }),
+                    guard_intersections: config.guard_intersections,
                     ..FaceCollapseOptions::default()
                 },
             }),
@@ -413,6 +406,7 @@ pub fn default_blocks(config: &ReconstructConfig) -> Vec<ScheduledBlock> {
                 options: FaceSplitOptions {
                     threshold: SplitThreshold::PerSubTriangle(config.split_threshold),
                     seed: config.seed,
+                    guard_intersections: config.guard_intersections,
                     ..FaceSplitOptions::default()
                 },
             }),
@@ -420,7 +414,12 @@ pub fn default_blocks(config: &ReconstructConfig) -> Vec<ScheduledBlock> {
             skip_first: true,
         },
         ScheduledBlock {
-            block: Box::new(TangentialSmoothing::default()),
+            block: Box::new(TangentialSmoothing {
+                options: SmoothingOptions {
+                    guard_intersections: config.guard_intersections,
+                    ..SmoothingOptions::default()
+                },
+            }),
             every: config.smoothing_interval,
             skip_first: false,
         },
@@ -498,6 +497,89 @@ fn target_cloud(
         )));
     }
     Ok(cloud)
+}
+
+/// A fresh optimizer for `mesh` with the configured learning rate and Laplacian weight.
+fn new_optimizer(mesh: &Mesh, config: &ReconstructConfig) -> Result<Optimizer, PipelineError> {
+    Optimizer::new(
+        mesh.vertex_capacity(),
+        OptimizerOptions {
+            lr: config.learning_rate,
+            laplacian_weight: config.laplacian_weight,
+            ..OptimizerOptions::default()
+        },
+    )
+    .map_err(|e| PipelineError::Config(e.to_string()))
+}
+
+/// One Move Vertices step (spec §3.2.4): the loss and its gradient on the compacted mesh, the
+/// optimizer step, then the step limiter if configured. Stage times go to `{stage}_loss`,
+/// `{stage}_step` and `{stage}_step_limiter`. Returns the loss before the step.
+fn move_vertices(
+    mesh: &mut Mesh,
+    optimizer: &mut Optimizer,
+    loss: &mut dyn Loss,
+    config: &ReconstructConfig,
+    stats: &mut RunStats,
+    clock: &mut StageClock,
+    stage: &str,
+) -> Result<IterationRecord, PipelineError> {
+    let triangles = compact_triangles(mesh, optimizer);
+    let (value, gradient) = loss.value_and_grad(mesh.positions(), &triangles)?;
+    let record = IterationRecord {
+        loss: value,
+        terms: loss.last_terms().into_iter().collect(),
+        faces: mesh.n_faces(),
+    };
+    clock.lap(&format!("{stage}_loss"));
+    let before = config.step_limiter.then(|| mesh.positions().to_vec());
+    optimizer
+        .step(mesh.positions_mut(), &triangles, &gradient)
+        .map_err(|e| PipelineError::Internal(e.to_string()))?;
+    clock.lap(&format!("{stage}_step"));
+    if let Some(before) = before {
+        let bvh = TriangleBvh::build(&before, &triangles);
+        let limited = limit_steps(
+            &before,
+            mesh.positions_mut(),
+            &triangles,
+            &bvh,
+            &LimiterOptions::default(),
+        );
+        stats.steps_shortened += limited.shortened + limited.cancelled;
+        clock.lap(&format!("{stage}_step_limiter"));
+    }
+    Ok(record)
+}
+
+/// `config.polish_iterations` Move Vertices steps on the final mesh, with a fresh optimizer and
+/// no blocks (so the face count and topology stay). Returns the polished mesh if it is free of
+/// self-intersections (the step limiter makes that the rule), else the mesh it was given.
+fn polish(
+    mesh: Mesh,
+    loss: &mut dyn Loss,
+    config: &ReconstructConfig,
+    stats: &mut RunStats,
+    clock: &mut StageClock,
+) -> Result<Mesh, PipelineError> {
+    let mut polished = mesh.clone();
+    let mut optimizer = new_optimizer(&polished, config)?;
+    for _ in 0..config.polish_iterations {
+        let record = move_vertices(
+            &mut polished,
+            &mut optimizer,
+            loss,
+            config,
+            stats,
+            clock,
+            "polish",
+        )?;
+        stats.polish_history.push(record);
+    }
+    let clean = is_intersection_free(&polished);
+    clock.lap("polish_check");
+    stats.polish_kept = clean;
+    Ok(if clean { polished } else { mesh })
 }
 
 /// The triangles of a compact mesh (compacting it, and the optimizer with it, if needed).
