@@ -7,7 +7,9 @@
 //! 2. close one-voxel gaps (26-neighbour dilation of the marked set), flood-fill the exterior from
 //!    the grid border (6-connectivity), then let the exterior grow back one voxel into untouched
 //!    voxels (the second half of a morphological closing, so the surface hugs the touched voxels
-//!    while gaps stay closed); everything not exterior is solid;
+//!    while gaps stay closed), never through a voxel that would join two exterior groups (so the
+//!    regrowth cuts no tunnel through a thin wall; module `simple`); everything not exterior is
+//!    solid;
 //! 3. repair the voxel set so that its boundary is a 2-manifold (module `solid`: non-manifold
 //!    edges and corners are resolved by adding voxels, which merges touching parts), and extract the
 //!    boundary squares as outward triangles;
@@ -22,6 +24,7 @@ mod grid;
 mod initial;
 mod pieces;
 mod project;
+mod simple;
 mod solid;
 mod surface;
 mod voxelize;
