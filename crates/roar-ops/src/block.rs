@@ -127,14 +127,13 @@ pub fn apply_collapse(
     mesh: &mut Mesh,
     optimizer: &mut Optimizer,
     c: &EdgeCost,
-    guard: Option<&mut IntersectionGuard>,
+    mut guard: Option<&mut IntersectionGuard>,
     stats: &mut BlockStats,
 ) -> bool {
     if mesh.can_collapse(c.halfedge).is_err() {
         stats.reject("link", 1);
         return false;
     }
-    let mut guard = guard;
     if let Some(guard) = guard.as_deref_mut() {
         let p = mesh.position(c.keep);
         if guard.collapse_intersects(mesh, c.halfedge, p) {

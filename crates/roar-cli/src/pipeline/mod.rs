@@ -24,7 +24,7 @@ use roar_loss::{
     PointCloudOptions, RenderLoss, SharpEdgeOptions, Target, TargetOptions, WeightedSum,
     build_target, point_cloud, sharp_edge_samples,
 };
-use roar_mesh::spatial::{TriangleBvh, self_intersecting_faces};
+use roar_mesh::spatial::{Normalization, TriangleBvh, self_intersecting_faces};
 use roar_mesh::{EdgeId, Mesh};
 use roar_ops::block::{Block, BlockContext, BlockStats};
 use roar_ops::collapse_block::{FaceCollapse, FaceCollapseOptions};
@@ -338,7 +338,14 @@ impl Reconstruction {
 
         if config.polish_iterations > 0 {
             report("polish", config.iterations, stats.loss_last, mesh.n_faces());
-            mesh = polish(mesh, loss.as_mut(), &config, &mut stats, &mut clock)?;
+            mesh = polish(
+                mesh,
+                loss.as_mut(),
+                &target.normalization,
+                &config,
+                &mut stats,
+                &mut clock,
+            )?;
         }
         drop(loss);
 
@@ -554,10 +561,13 @@ fn move_vertices(
 
 /// `config.polish_iterations` Move Vertices steps on the final mesh, with a fresh optimizer and
 /// no blocks (so the face count and topology stay). Returns the polished mesh if it is free of
-/// self-intersections (the step limiter makes that the rule), else the mesh it was given.
+/// self-intersections in the input's coordinates, where it will be written (the step limiter
+/// makes that the rule, but it may leave faces closer than the untangle margin, and undoing the
+/// normalization rounds), else the mesh it was given.
 fn polish(
     mesh: Mesh,
     loss: &mut dyn Loss,
+    normalization: &Normalization,
     config: &ReconstructConfig,
     stats: &mut RunStats,
     clock: &mut StageClock,
@@ -576,7 +586,9 @@ fn polish(
         )?;
         stats.polish_history.push(record);
     }
-    let clean = is_intersection_free(&polished);
+    let (mut positions, triangles) = polished.to_triangles();
+    normalization.invert_all(&mut positions);
+    let clean = !self_intersecting_faces(&positions, &triangles).contains(&true);
     clock.lap("polish_check");
     stats.polish_kept = clean;
     Ok(if clean { polished } else { mesh })
