@@ -107,10 +107,11 @@ pub struct ReconstructConfig {
     /// Separation margin of the untangle block, relative to the bounding-box diagonal.
     pub untangle_margin: f64,
     /// Move Vertices iterations at exactly N after the final QEM (0 = off), with the step
-    /// limiter and no blocks, so the face count and topology stay. [INF] Not in the paper: the
-    /// final QEM places vertices at quadric minimisers of the working-budget surface, not on the
-    /// target, and a 5:1 decimation leaves visible error a few loss-driven steps remove. If the
-    /// polished mesh intersects itself, the QEM output is kept (the report says so).
+    /// limiter, a learning rate falling linearly to 0 and no blocks, so the face count and
+    /// topology stay; the state with the lowest loss is kept. [INF] Not in the paper: the final
+    /// QEM places vertices at quadric minimisers of the working-budget surface, not on the
+    /// target. If the kept mesh intersects itself, the QEM output is kept (the report says so).
+    /// Runs only when `iterations > 0`, so `--iterations 0` stays the plain init + QEM.
     pub polish_iterations: usize,
     /// Write the closest mesh when the final QEM cannot reach the budget, instead of failing.
     pub best_effort: bool,

@@ -149,7 +149,8 @@ pub struct RunStats {
     pub final_collapses: usize,
     /// Loss, terms and faces at every polish iteration (after the final QEM).
     pub polish_history: Vec<IterationRecord>,
-    /// Whether the polished mesh was kept (false: it intersected itself, or no polish ran).
+    /// Whether the polished mesh was kept (false: it intersected itself, or no polish ran; true
+    /// also when its best state was the unpolished one).
     pub polish_kept: bool,
 }
 
@@ -336,7 +337,8 @@ impl Reconstruction {
         stats.final_collapses = decimated.collapses;
         clock.lap("final_qem");
 
-        if config.polish_iterations > 0 {
+        // No Move Vertices step at all with `iterations = 0`: that run is the plain init + QEM.
+        if config.iterations > 0 && config.polish_iterations > 0 {
             report("polish", config.iterations, stats.loss_last, mesh.n_faces());
             mesh = polish(
                 mesh,
@@ -559,11 +561,14 @@ fn move_vertices(
     Ok(record)
 }
 
-/// `config.polish_iterations` Move Vertices steps on the final mesh, with a fresh optimizer and
-/// no blocks (so the face count and topology stay). Returns the polished mesh if it is free of
-/// self-intersections in the input's coordinates, where it will be written (the step limiter
-/// makes that the rule, but it may leave faces closer than the untangle margin, and undoing the
-/// normalization rounds), else the mesh it was given.
+/// `config.polish_iterations` Move Vertices steps on the final mesh, with a fresh optimizer, a
+/// learning rate falling linearly to 0 (a constant rate leaves the vertices jittering by about
+/// η·ℓ_v, which on a converged mesh is all a step does) and no blocks, so the face count and
+/// topology stay. Keeps the evaluated state with the lowest loss (the given mesh is state 0, so
+/// the polish never raises the loss), and only if it is free of self-intersections in the
+/// input's coordinates, where it will be written (the step limiter makes that the rule, but
+/// may leave faces closer than the untangle margin, and undoing the normalization rounds);
+/// otherwise returns the mesh it was given.
 fn polish(
     mesh: Mesh,
     loss: &mut dyn Loss,
@@ -572,11 +577,19 @@ fn polish(
     stats: &mut RunStats,
     clock: &mut StageClock,
 ) -> Result<Mesh, PipelineError> {
-    let mut polished = mesh.clone();
-    let mut optimizer = new_optimizer(&polished, config)?;
-    for _ in 0..config.polish_iterations {
+    let mut current = mesh.clone();
+    let mut optimizer = new_optimizer(&current, config)?;
+    let mut best: Option<(f64, Mesh)> = None;
+    let steps = config.polish_iterations;
+    for k in 0..steps {
+        let mut options = *optimizer.options();
+        options.lr = config.learning_rate * (steps - k) as f64 / steps as f64;
+        optimizer
+            .set_options(options)
+            .map_err(|e| PipelineError::Internal(e.to_string()))?;
+        let before = current.clone();
         let record = move_vertices(
-            &mut polished,
+            &mut current,
             &mut optimizer,
             loss,
             config,
@@ -584,14 +597,20 @@ fn polish(
             clock,
             "polish",
         )?;
+        if best.as_ref().is_none_or(|(l, _)| record.loss < *l) {
+            best = Some((record.loss, before));
+        }
         stats.polish_history.push(record);
     }
-    let (mut positions, triangles) = polished.to_triangles();
+    let Some((_, best)) = best else {
+        return Ok(mesh);
+    };
+    let (mut positions, triangles) = best.to_triangles();
     normalization.invert_all(&mut positions);
     let clean = !self_intersecting_faces(&positions, &triangles).contains(&true);
     clock.lap("polish_check");
     stats.polish_kept = clean;
-    Ok(if clean { polished } else { mesh })
+    Ok(if clean { best } else { mesh })
 }
 
 /// The triangles of a compact mesh (compacting it, and the optimizer with it, if needed).
