@@ -44,7 +44,7 @@ pub struct FaceCollapseOptions {
     pub flips: Option<FlipOptions>,
     /// Skip collapses that would make a face intersect another one
     /// ([`IntersectionGuard`], `rejected["intersection"]`). Default off (the paper's block);
-    /// the pipeline switches it on. [INF]
+    /// the pipeline's `guard_intersections` key switches it on. [INF]
     pub guard_intersections: bool,
 }
 

@@ -34,8 +34,8 @@ pub struct FlipOptions {
     /// Tolerance of the normal check `N_old · n_new > −tol`. Default 1e-8 (§3.7 step 2).
     pub normal_tolerance: f64,
     /// Skip flips whose new faces would intersect another face ([`IntersectionGuard`],
-    /// `rejected["intersection"]`). Default off (the paper's block); the pipeline switches it
-    /// on. [INF]
+    /// `rejected["intersection"]`). Default off (the paper's block); the pipeline's
+    /// `guard_intersections` key switches it on. [INF]
     pub guard_intersections: bool,
 }
 

@@ -22,7 +22,7 @@ pub struct SmoothingOptions {
     pub min_normal_magnitude: f64,
     /// Shorten or cancel moves that would make faces intersect ([`limit_steps`], counted in
     /// `counters["shortened"]`, `counters["cancelled"]`). Default off (the paper's block); the
-    /// pipeline switches it on. [INF]
+    /// pipeline's `guard_intersections` key switches it on. [INF]
     pub guard_intersections: bool,
 }
 

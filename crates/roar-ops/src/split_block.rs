@@ -83,7 +83,7 @@ pub struct FaceSplitOptions {
     /// Skip budget collapses that would make a face intersect another one
     /// ([`IntersectionGuard`], `rejected["intersection"]`; the swap's split is dropped with it).
     /// The centroid splits move no geometry and need no guard. Default off (the paper's block);
-    /// the pipeline switches it on. [INF]
+    /// the pipeline's `guard_intersections` key switches it on. [INF]
     pub guard_intersections: bool,
 }
 
