@@ -6,7 +6,7 @@
 
 use roar_cli::pipeline::{ReconstructConfig, Reconstruction, ScheduledBlock};
 use roar_mesh::Mesh;
-use roar_mesh::spatial::self_intersecting_faces;
+use roar_mesh::spatial::count_intersecting_faces;
 use roar_ops::block::{Block, BlockContext, BlockStats};
 use roar_ops::optim::Optimizer;
 use std::cell::RefCell;
@@ -37,14 +37,6 @@ struct Counted {
     tally: Tally,
 }
 
-fn intersecting(mesh: &Mesh) -> usize {
-    let (p, t) = mesh.to_triangles();
-    self_intersecting_faces(&p, &t)
-        .iter()
-        .filter(|&&b| b)
-        .count()
-}
-
 impl Block for Counted {
     fn name(&self) -> &'static str {
         self.inner.name()
@@ -56,9 +48,9 @@ impl Block for Counted {
         optimizer: &mut Optimizer,
         ctx: &BlockContext,
     ) -> BlockStats {
-        let before = intersecting(mesh);
+        let before = count_intersecting_faces(mesh);
         let stats = self.inner.apply(mesh, optimizer, ctx);
-        let after = intersecting(mesh);
+        let after = count_intersecting_faces(mesh);
         let mut counts = self.tally.borrow_mut();
         let last = counts.last;
         raise(&mut counts, "optimizer step (with limiter)", last, before);

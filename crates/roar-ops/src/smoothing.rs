@@ -10,8 +10,7 @@
 use crate::block::{Block, BlockContext, BlockStats};
 use crate::geometry::Geometry;
 use crate::optim::Optimizer;
-use crate::untangle::{LimiterOptions, limit_steps};
-use roar_mesh::spatial::TriangleBvh;
+use crate::untangle::{LimiterOptions, limit_moves};
 use roar_mesh::{DVec3, Mesh};
 
 /// Options of [`tangential_smoothing`] (spec §3.9).
@@ -20,7 +19,7 @@ pub struct SmoothingOptions {
     /// Vertices with normal magnitude μ_v below this stay put (creases, spikes, folds).
     /// Default 0.98 ([SUP], §3.9).
     pub min_normal_magnitude: f64,
-    /// Shorten or cancel moves that would make faces intersect ([`limit_steps`], counted in
+    /// Shorten or cancel moves that would make faces intersect ([`limit_moves`], counted in
     /// `counters["shortened"]`, `counters["cancelled"]`). Default off (the paper's block); the
     /// pipeline's `guard_intersections` key switches it on. [INF]
     pub guard_intersections: bool,
@@ -79,12 +78,10 @@ pub fn tangential_smoothing(mesh: &mut Mesh, options: &SmoothingOptions) -> Bloc
             .faces()
             .map(|f| mesh.face_vertices(f).map(|v| v.raw()))
             .collect();
-        let bvh = TriangleBvh::build(&before, &triangles);
-        let limited = limit_steps(
+        let limited = limit_moves(
             &before,
             mesh.positions_mut(),
             &triangles,
-            &bvh,
             &LimiterOptions::default(),
         );
         stats.count("shortened", limited.shortened);

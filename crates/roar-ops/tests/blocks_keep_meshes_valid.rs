@@ -6,7 +6,7 @@ mod blocks_common;
 use blocks_common::{assert_contract, random_mesh, tagged_optimizer};
 use proptest::prelude::*;
 use roar_mesh::Mesh;
-use roar_mesh::spatial::{SphereProjector, self_intersecting_faces};
+use roar_mesh::spatial::{SphereProjector, count_intersecting_faces};
 use roar_ops::block::{Block, BlockContext};
 use roar_ops::collapse_block::{FaceCollapse, FaceCollapseOptions};
 use roar_ops::flips::{EdgeFlips, FlipOptions};
@@ -65,14 +65,6 @@ fn guarded_blocks() -> Vec<Box<dyn Block>> {
     ]
 }
 
-fn intersecting_faces(mesh: &Mesh) -> usize {
-    let (p, t) = mesh.to_triangles();
-    self_intersecting_faces(&p, &t)
-        .iter()
-        .filter(|&&b| b)
-        .count()
-}
-
 /// A jittered random mesh squashed along z to `thickness` of its height: the opposite walls
 /// are a fraction of an edge apart, where collapses and smoothing moves cross them.
 fn thin_mesh(kind: u8, thickness: f64, jitter: f64, seed: u64) -> Mesh {
@@ -91,7 +83,7 @@ fn max_crossings(
     sequence: &[usize],
     budget_offset: i64,
 ) -> Option<usize> {
-    if intersecting_faces(mesh) > 0 {
+    if count_intersecting_faces(mesh) > 0 {
         return None;
     }
     let euler = mesh.euler_characteristic();
@@ -110,7 +102,7 @@ fn max_crossings(
         };
         blocks[i].apply(mesh, &mut opt, &ctx);
         assert_contract(mesh, &opt, euler, blocks[i].name());
-        worst = worst.max(intersecting_faces(mesh));
+        worst = worst.max(count_intersecting_faces(mesh));
     }
     Some(worst)
 }

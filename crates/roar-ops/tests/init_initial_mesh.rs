@@ -177,7 +177,7 @@ fn check_initial_mesh(case: &Case) -> String {
     assert_eq!(mesh.n_faces(), stats.final_faces);
     let volume = mesh.signed_volume();
     assert!(volume > 0.0, "{name}: volume {volume}");
-    let crossing = common::intersecting_faces(mesh);
+    let crossing = roar_mesh::spatial::count_intersecting_faces(mesh);
     assert_eq!(crossing, 0, "{name}: {crossing} self-intersecting faces");
     let (positions, triangles) = mesh.to_triangles();
     let chamfer_options = ChamferOptions {
@@ -259,7 +259,7 @@ fn check_decimated(name: &str, budget: usize, m: &Mesh, genera: &[usize]) {
         after, genera,
         "{name} @ {budget}: components/genera changed"
     );
-    let crossing = common::intersecting_faces(m);
+    let crossing = roar_mesh::spatial::count_intersecting_faces(m);
     assert_eq!(
         crossing, 0,
         "{name} @ {budget}: {crossing} self-intersecting faces"

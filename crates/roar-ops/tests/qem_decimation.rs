@@ -20,7 +20,7 @@ fn decimate_and_check(mesh: &Mesh, target: usize) -> Mesh {
     assert_eq!(m.components().0, components);
     assert_eq!(m.genus(), genus);
     assert_eq!(
-        common::intersecting_faces(&m),
+        roar_mesh::spatial::count_intersecting_faces(&m),
         0,
         "self-intersections after decimation to {target}"
     );
@@ -151,7 +151,7 @@ fn blocked_budget_is_a_named_error_or_the_closest_mesh_with_best_effort() {
         "best effort keeps the same closest mesh"
     );
     m.validate().unwrap();
-    assert_eq!(common::intersecting_faces(&m), 0);
+    assert_eq!(roar_mesh::spatial::count_intersecting_faces(&m), 0);
 }
 
 proptest! {
@@ -165,7 +165,7 @@ proptest! {
     ) {
         let base = if use_torus { torus(20, 10, 1.0, 0.4) } else { icosphere(3) };
         let mesh = perturbed(&base, amplitude, seed);
-        let clean = common::intersecting_faces(&mesh) == 0;
+        let clean = roar_mesh::spatial::count_intersecting_faces(&mesh) == 0;
         let target = ((base.n_faces() as f64 * frac) as usize / 2 * 2).max(minimum_faces(&base));
         let mut m = mesh.clone();
         let opts = DecimateOptions { best_effort: true, ..DecimateOptions::default() };
@@ -174,7 +174,7 @@ proptest! {
         prop_assert_eq!(m.genus(), base.genus());
         prop_assert!(m.n_faces() >= target);
         if clean {
-            prop_assert_eq!(common::intersecting_faces(&m), 0);
+            prop_assert_eq!(roar_mesh::spatial::count_intersecting_faces(&m), 0);
         }
         if stats.reached_target {
             prop_assert_eq!(m.n_faces(), target);

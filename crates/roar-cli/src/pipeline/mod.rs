@@ -24,7 +24,7 @@ use roar_loss::{
     PointCloudOptions, RenderLoss, SharpEdgeOptions, Target, TargetOptions, WeightedSum,
     build_target, point_cloud, sharp_edge_samples,
 };
-use roar_mesh::spatial::{Normalization, TriangleBvh, self_intersecting_faces};
+use roar_mesh::spatial::{Normalization, count_intersecting_faces, self_intersecting_faces};
 use roar_mesh::{EdgeId, Mesh};
 use roar_ops::block::{Block, BlockContext, BlockStats};
 use roar_ops::collapse_block::{FaceCollapse, FaceCollapseOptions};
@@ -34,7 +34,7 @@ use roar_ops::optim::{Optimizer, OptimizerOptions};
 use roar_ops::qem::{DecimateError, DecimateOptions, DecimateStats, decimate};
 use roar_ops::smoothing::{SmoothingOptions, TangentialSmoothing};
 use roar_ops::split_block::{FaceSplit, FaceSplitOptions, SplitThreshold};
-use roar_ops::untangle::{LimiterOptions, UntangleOptions, UntangleStats, limit_steps, untangle};
+use roar_ops::untangle::{LimiterOptions, UntangleOptions, UntangleStats, limit_moves, untangle};
 use serde::Serialize;
 
 pub use config::{InitKind, ReconstructConfig};
@@ -304,7 +304,7 @@ impl Reconstruction {
             }
             let done = iteration + 1;
             if config.checkpoint_interval > 0 && done % config.checkpoint_interval == 0 {
-                if is_intersection_free(&mesh) {
+                if count_intersecting_faces(&mesh) == 0 {
                     checkpoint = (done, mesh.clone());
                 }
                 clock.lap("loop_checkpoint");
@@ -547,12 +547,10 @@ fn move_vertices(
         .map_err(|e| PipelineError::Internal(e.to_string()))?;
     clock.lap(&format!("{stage}_step"));
     if let Some(before) = before {
-        let bvh = TriangleBvh::build(&before, &triangles);
-        let limited = limit_steps(
+        let limited = limit_moves(
             &before,
             mesh.positions_mut(),
             &triangles,
-            &bvh,
             &LimiterOptions::default(),
         );
         stats.steps_shortened += limited.shortened + limited.cancelled;
@@ -663,12 +661,6 @@ fn fill_and_untangle(mesh: &mut Mesh, config: &ReconstructConfig, stats: &mut Ru
     untangled.unresolved_faces.len()
 }
 
-/// Whether no two non-adjacent faces of `mesh` intersect (exact test).
-fn is_intersection_free(mesh: &Mesh) -> bool {
-    let (positions, triangles) = mesh.to_triangles();
-    !self_intersecting_faces(&positions, &triangles).contains(&true)
-}
-
 /// The guaranteed QEM to exactly `config.faces` (best effort only if configured).
 fn final_decimation(
     mesh: &mut Mesh,
@@ -769,6 +761,6 @@ mod tests {
         assert!(stats.fill_splits > 0, "the untangle collapsed nothing");
         mesh.validate().unwrap();
         assert_eq!(mesh.n_faces(), faces);
-        assert!(is_intersection_free(&mesh));
+        assert!(count_intersecting_faces(&mesh) == 0);
     }
 }

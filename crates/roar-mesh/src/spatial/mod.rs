@@ -38,7 +38,9 @@ pub use regular_sampling::{
     grid_point_count, regular_sample_points, regular_sample_points_into, regular_samples,
 };
 pub use sampling::{SurfaceSamples, sample_surface};
-pub use self_intersections::{face_intersects_any, intersecting_pairs, self_intersecting_faces};
+pub use self_intersections::{
+    count_intersecting_faces, face_intersects_any, intersecting_pairs, self_intersecting_faces,
+};
 pub use tri_tri::{faces_intersect, segment_intersects_triangle, triangles_intersect};
 pub use winding::{
     TriangleIndexError, WindingNumber, WindingNumberOptions, exact_winding_number,

@@ -15,6 +15,7 @@ use rayon::prelude::*;
 use super::aabb::Aabb;
 use super::bvh::TriangleBvh;
 use super::tri_tri::faces_intersect;
+use crate::Mesh;
 
 /// Faces per parallel work item (small meshes run on one thread).
 const CHUNK_FACES: usize = 2048;
@@ -78,6 +79,16 @@ pub fn self_intersecting_faces(positions: &[DVec3], triangles: &[[u32; 3]]) -> V
         flags[j as usize] = true;
     }
     flags
+}
+
+/// How many live faces of `mesh` intersect another face ([`self_intersecting_faces`] of its
+/// compacted triangles).
+pub fn count_intersecting_faces(mesh: &Mesh) -> usize {
+    let (positions, triangles) = mesh.to_triangles();
+    self_intersecting_faces(&positions, &triangles)
+        .iter()
+        .filter(|&&f| f)
+        .count()
 }
 
 /// Whether the triangle `candidate` (indices into `positions`, not necessarily a face of the

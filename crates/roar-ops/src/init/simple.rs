@@ -142,9 +142,7 @@ mod tests {
 
     #[test]
     fn exterior_groups_connect_only_through_faces() {
-        // Two exterior voxels at opposite edges of the centre, not face-adjacent to each other,
-        // each touching a face of the centre through... none: edge neighbours alone do not
-        // count, so take face neighbours above and below instead.
+        // Exterior face neighbours above and below, not connected inside N18: two groups.
         assert_eq!(
             exterior_groups(mask(|o| o == [0, 0, 1] || o == [0, 0, -1])),
             2

@@ -144,3 +144,15 @@ pub fn limit_steps(
     }
     stats
 }
+
+/// [`limit_steps`] with a BVH built over `before` and `triangles`, for callers that have none
+/// to refit (the pipeline's optimizer step, guarded smoothing).
+pub fn limit_moves(
+    before: &[DVec3],
+    proposed: &mut [DVec3],
+    triangles: &[[u32; 3]],
+    options: &LimiterOptions,
+) -> LimiterStats {
+    let bvh = TriangleBvh::build(before, triangles);
+    limit_steps(before, proposed, triangles, &bvh, options)
+}

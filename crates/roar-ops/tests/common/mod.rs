@@ -299,12 +299,3 @@ pub fn first_intersections(
     }
     found
 }
-
-/// Faces of `mesh` that intersect a non-adjacent face (exact test of `roar_mesh::spatial`).
-pub fn intersecting_faces(mesh: &roar_mesh::Mesh) -> usize {
-    let (p, t) = mesh.to_triangles();
-    roar_mesh::spatial::self_intersecting_faces(&p, &t)
-        .iter()
-        .filter(|&&x| x)
-        .count()
-}
