@@ -5,7 +5,9 @@ mod common;
 use proptest::prelude::*;
 use roar_mesh::Mesh;
 use roar_mesh::shapes::{icosphere, perturbed, torus};
-use roar_ops::qem::{DecimateError, DecimateOptions, decimate, decimate_with, minimum_faces};
+use roar_ops::qem::{
+    DecimateError, DecimateOptions, decimate, decimate_in_parallel, decimate_with, minimum_faces,
+};
 
 /// Decimates a copy to `target` and checks every promise of `decimate`.
 fn decimate_and_check(mesh: &Mesh, target: usize) -> Mesh {
@@ -152,6 +154,69 @@ fn blocked_budget_is_a_named_error_or_the_closest_mesh_with_best_effort() {
     );
     m.validate().unwrap();
     assert_eq!(roar_mesh::spatial::count_intersecting_faces(&m), 0);
+}
+
+/// Two concentric spheres 0.5 % of the radius apart (two components, 2 × 81 920 faces): a
+/// collapse on either shell that moved a vertex by more than the gap would cross the other one.
+fn nested_shells() -> Mesh {
+    let (outer_p, outer_t) = icosphere(6).to_triangles();
+    let (inner_p, inner_t) = icosphere(6).to_triangles();
+    let offset = outer_p.len() as u32;
+    let positions: Vec<_> = outer_p
+        .into_iter()
+        .chain(inner_p.into_iter().map(|p| 0.995 * p))
+        .collect();
+    let triangles: Vec<[u32; 3]> = outer_t
+        .into_iter()
+        .chain(inner_t.into_iter().map(|t| t.map(|v| v + offset)))
+        .collect();
+    Mesh::from_triangles(positions, &triangles).expect("two closed shells")
+}
+
+/// The two-thread decimation keeps every promise of `decimate` on a large mesh where the
+/// intersection veto matters, and gives the same bytes on one thread and on two.
+#[test]
+fn parallel_decimation_keeps_the_promises_and_ignores_the_thread_count() {
+    let shells = nested_shells();
+    assert_eq!(roar_mesh::spatial::count_intersecting_faces(&shells), 0);
+    let run = |threads: usize| {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        pool.install(|| {
+            let mut m = shells.clone();
+            let stats = decimate_in_parallel(&mut m, 2000, &DecimateOptions::default())
+                .unwrap_or_else(|e| panic!("parallel decimation: {e}"));
+            (m, stats)
+        })
+    };
+    let (m, stats) = run(2);
+    assert_eq!(m.n_faces(), 2000);
+    assert!(stats.reached_target && stats.remap.is_none());
+    assert_eq!(stats.initial_faces, shells.n_faces());
+    assert_eq!(stats.collapses, (shells.n_faces() - 2000) / 2);
+    m.validate().expect("valid after parallel decimation");
+    assert_eq!(m.components().0, 2);
+    assert_eq!(m.genus(), 0);
+    assert_eq!(roar_mesh::spatial::count_intersecting_faces(&m), 0);
+    assert!(m.signed_volume() > 0.0);
+    let (one_thread, _) = run(1);
+    assert_eq!(one_thread.to_triangles(), m.to_triangles());
+}
+
+/// Small meshes and errors behave exactly as with `decimate`.
+#[test]
+fn parallel_decimation_of_small_meshes_is_decimate() {
+    let t = torus(40, 20, 1.0, 0.35);
+    let mut a = t.clone();
+    let mut b = t.clone();
+    let sa = decimate(&mut a, 500, &DecimateOptions::default()).unwrap();
+    let sb = decimate_in_parallel(&mut b, 500, &DecimateOptions::default()).unwrap();
+    assert_eq!(sa, sb);
+    assert_eq!(a, b);
+    let err = decimate_in_parallel(&mut b, 101, &DecimateOptions::default()).unwrap_err();
+    assert!(matches!(err, DecimateError::OddTarget { .. }));
 }
 
 proptest! {

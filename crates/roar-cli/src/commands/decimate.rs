@@ -5,7 +5,7 @@
 use std::path::PathBuf;
 
 use clap::Args;
-use roar_ops::qem::{DecimateOptions, decimate};
+use roar_ops::qem::{DecimateOptions, decimate_in_parallel};
 
 use crate::input::{read_closed_mesh, write_mesh};
 
@@ -32,7 +32,7 @@ pub fn run(args: &DecimateArgs) -> anyhow::Result<()> {
         best_effort: args.best_effort,
         ..DecimateOptions::default()
     };
-    let stats = decimate(&mut mesh, args.faces, &options)?;
+    let stats = decimate_in_parallel(&mut mesh, args.faces, &options)?;
     write_mesh(&args.output, &mesh)?;
     if stats.reached_target {
         eprintln!(

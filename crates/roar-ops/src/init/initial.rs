@@ -1,7 +1,7 @@
 //! The pipeline's initial mesh (spec §4.1: watertight init, then QEM to at most 20k faces).
 
 use super::{InitError, InitOptions, InitStats, WatertightInit, watertight_init};
-use crate::qem::{DecimateOptions, DecimateStats, decimate, minimum_faces};
+use crate::qem::{DecimateOptions, DecimateStats, decimate_in_parallel, minimum_faces};
 use glam::DVec3;
 use roar_mesh::Mesh;
 use std::time::Instant;
@@ -48,7 +48,7 @@ pub struct InitialMeshStats {
 }
 
 /// Builds the initial mesh of a triangle soup: [`watertight_init`], then QEM decimation
-/// ([`decimate`], every veto on) to at most `max_faces` faces when the init has more.
+/// ([`decimate_in_parallel`], every veto on) to at most `max_faces` faces when the init has more.
 ///
 /// Promises: a valid closed, oriented 2-manifold [`Mesh`]; the decimation target is the largest
 /// even count ≤ `max_faces` (raised to the minimum the components and genera allow); when the
@@ -91,7 +91,7 @@ pub fn initial_mesh_from_init(
             best_effort: true,
             ..options.decimate.clone()
         };
-        let stats = decimate(&mut mesh, target, &decimate_options)
+        let stats = decimate_in_parallel(&mut mesh, target, &decimate_options)
             .map_err(|e| InitError::Internal(format!("decimation failed: {e}")))?;
         decimate_stats = Some(stats);
     }

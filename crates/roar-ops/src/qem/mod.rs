@@ -24,10 +24,15 @@
 //! collapses elsewhere may have unblocked them) and, when a whole pass makes no progress, the
 //! quality bound is relaxed stepwise (`quality_bounds`, 5 → 10 → 20). The manifold,
 //! orientation and intersection vetoes are never relaxed.
+//!
+//! [`decimate_in_parallel`] gives the same promises on two threads for large meshes (the initial
+//! mesh and `roar decimate`): the two halves of the mesh are decimated at once, then the whole
+//! (module `split` proves why nothing is lost).
 
 mod grid;
 mod heap;
 mod quadric;
+mod split;
 
 use crate::intersect::{faces_intersect_filtered, fan_is_embedded};
 use glam::DVec3;
@@ -37,6 +42,8 @@ use quadric::{Quadric, placement};
 use roar_mesh::spatial::Aabb;
 use roar_mesh::{Collapse, EdgeId, FaceId, HalfedgeId, Mesh, Remap, VertexId};
 use std::fmt;
+
+pub use split::decimate_in_parallel;
 
 /// Options of [`decimate`]. `Default` gives the values used by the pipeline.
 #[derive(Debug, Clone, PartialEq)]
@@ -93,7 +100,7 @@ impl VetoCounts {
         self.topology + self.normal_flip + self.degenerate + self.quality + self.self_intersection
     }
 
-    fn add(&mut self, o: &VetoCounts) {
+    pub(crate) fn add(&mut self, o: &VetoCounts) {
         self.topology += o.topology;
         self.normal_flip += o.normal_flip;
         self.degenerate += o.degenerate;
@@ -245,40 +252,10 @@ pub fn decimate_with(
     options: &DecimateOptions,
     on_collapse: impl FnMut(&Collapse),
 ) -> Result<DecimateStats, DecimateError> {
-    check_options(options)?;
-    if target_faces % 2 == 1 {
-        return Err(DecimateError::OddTarget {
-            target: target_faces,
-            below: target_faces - 1,
-            above: target_faces + 1,
-        });
-    }
     let initial = mesh.n_faces();
-    if target_faces >= initial {
-        return Ok(DecimateStats {
-            initial_faces: initial,
-            final_faces: initial,
-            target: target_faces,
-            reached_target: target_faces == initial,
-            noop: true,
-            collapses: 0,
-            vetoes: VetoCounts::default(),
-            quality_bound: None,
-            passes: 0,
-            max_cost: 0.0,
-            remap: None,
-        });
+    if let Some(noop) = check_request(mesh, target_faces, options)? {
+        return Ok(noop);
     }
-    let minimum = minimum_faces(mesh);
-    if target_faces < minimum {
-        return Err(DecimateError::TargetBelowMinimum {
-            target: target_faces,
-            minimum,
-            components: mesh.components().0,
-            genus: mesh.genus(),
-        });
-    }
-
     let mut run = Decimator::new(mesh, options, on_collapse);
     let mut last_pass = VetoCounts::default();
     let mut bound_used = options.quality_bounds[0];
@@ -320,6 +297,49 @@ pub fn decimate_with(
         max_cost: stats_core.3,
         remap: Some(remap),
     })
+}
+
+/// The up-front checks of [`decimate_with`]: `Err` for a bad option, an odd target or one below
+/// the minimum; `Ok(Some(stats))` when the target is at or above the face count (nothing to do).
+fn check_request(
+    mesh: &Mesh,
+    target_faces: usize,
+    options: &DecimateOptions,
+) -> Result<Option<DecimateStats>, DecimateError> {
+    check_options(options)?;
+    if target_faces % 2 == 1 {
+        return Err(DecimateError::OddTarget {
+            target: target_faces,
+            below: target_faces - 1,
+            above: target_faces + 1,
+        });
+    }
+    let initial = mesh.n_faces();
+    if target_faces >= initial {
+        return Ok(Some(DecimateStats {
+            initial_faces: initial,
+            final_faces: initial,
+            target: target_faces,
+            reached_target: target_faces == initial,
+            noop: true,
+            collapses: 0,
+            vetoes: VetoCounts::default(),
+            quality_bound: None,
+            passes: 0,
+            max_cost: 0.0,
+            remap: None,
+        }));
+    }
+    let minimum = minimum_faces(mesh);
+    if target_faces < minimum {
+        return Err(DecimateError::TargetBelowMinimum {
+            target: target_faces,
+            minimum,
+            components: mesh.components().0,
+            genus: mesh.genus(),
+        });
+    }
+    Ok(None)
 }
 
 fn check_options(o: &DecimateOptions) -> Result<(), DecimateError> {
@@ -365,6 +385,9 @@ struct Decimator<'m, F: FnMut(&Collapse)> {
     heap: EdgeHeap,
     grid: Option<FaceGrid>,
     grid_faces: usize,
+    /// When set, only collapses whose star and placement lie inside this slab are made
+    /// (module `split`).
+    region: Option<split::Slab>,
     /// Scratch: the corners (before the collapse) of the fan of the collapse being checked.
     fan: Vec<[VertexId; 3]>,
     /// Scratch: the fan's faces after the collapse (relabelled corners) and their boxes.
@@ -411,6 +434,7 @@ impl<'m, F: FnMut(&Collapse)> Decimator<'m, F> {
             quadrics,
             grid: None,
             grid_faces: 0,
+            region: None,
             fan: Vec::new(),
             fan_scratch: Vec::new(),
             near_scratch: Vec::new(),
@@ -460,7 +484,17 @@ impl<'m, F: FnMut(&Collapse)> Decimator<'m, F> {
     /// reached or the heap is empty. Returns the vetoes of this pass.
     fn pass(&mut self, target_faces: usize, bound: f64) -> VetoCounts {
         self.passes += 1;
-        let edges: Vec<EdgeId> = self.mesh.edges().collect();
+        let edges: Vec<EdgeId> = match self.region {
+            None => self.mesh.edges().collect(),
+            Some(slab) => self
+                .mesh
+                .edges()
+                .filter(|&e| {
+                    let [u, v] = self.mesh.edge_vertices(e);
+                    slab.contains(self.mesh.position(u)) && slab.contains(self.mesh.position(v))
+                })
+                .collect(),
+        };
         let entries: Vec<(f64, u32)> = edges.iter().map(|&e| (self.evaluate(e), e.raw())).collect();
         self.heap.rebuild(entries);
         let mut vetoes = VetoCounts::default();
@@ -475,6 +509,12 @@ impl<'m, F: FnMut(&Collapse)> Decimator<'m, F> {
                 continue;
             }
             let target = self.targets[e.index()];
+            if self
+                .region
+                .is_some_and(|slab| !slab.holds_collapse(self.mesh, h, target))
+            {
+                continue;
+            }
             match self.geometric_veto(h, target, bound) {
                 Some(Veto::NormalFlip) => vetoes.normal_flip += 1,
                 Some(Veto::Degenerate) => vetoes.degenerate += 1,

@@ -1,0 +1,224 @@
+//! Decimation of large meshes on two threads: the two halves of the mesh, away from a band
+//! around a cutting plane, are decimated at the same time, then the whole mesh sequentially.
+//!
+//! ```text
+//!              low slab          band          high slab
+//!        ┌──────────────────┬─────────────┬──────────────────┐
+//!        │ collapsed by     │ frozen in   │ collapsed by     │
+//!        │ thread 1 only    │ phase 1     │ thread 2 only    │
+//!        └──────────────────┴─────────────┴──────────────────┘
+//!                       c − m      c      c + m         (along the longest axis)
+//! ```
+//!
+//! **Why the result is what one thread would allow.** Let `m` be the longest edge, so no edge
+//! joins a low vertex (coordinate `< c − m`) to a high one (`> c + m`). Thread 1 works on a copy
+//! of the mesh and makes only collapses whose star (every vertex around both endpoints) and
+//! placement are low, so every face it changes or creates has only low corners and lies in the
+//! half-space `x < c − m`, and it never touches a face with a band or high corner; likewise
+//! thread 2 on the high side. Hence no edge ever joins the two sides, the faces the two threads
+//! change are disjoint, and the merged mesh (low faces from copy 1, high faces from copy 2, the
+//! untouched band faces from either) is what applying both collapse sequences to one mesh gives:
+//! each collapse sees the same star and link as in its own copy, so the mesh stays a closed
+//! oriented 2-manifold with the same components and genera. Every collapse passed the full
+//! veto of its copy, and a face pair of the merged mesh either lies in one copy's final mesh,
+//! or has one face changed by each thread, in disjoint half-spaces: no self-intersection is
+//! created. The sequential [`decimate`] then reaches the exact target from the merged mesh with
+//! the usual promises.
+//!
+//! Each side is decimated to its share of twice the target, so the last halving (and the band)
+//! is done in the global cheapest-first order. The answer does not depend on the thread count.
+
+use super::{
+    DecimateError, DecimateOptions, DecimateStats, Decimator, VetoCounts, check_request, decimate,
+};
+use glam::DVec3;
+use roar_mesh::{HalfedgeId, Mesh};
+
+/// Meshes with fewer faces are decimated sequentially ([`decimate`]); below it the copies and
+/// the merge cost more than the second thread saves.
+const MIN_FACES_TO_SPLIT: usize = 50_000;
+
+/// An open slab `lo < p[axis] < hi`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(super) struct Slab {
+    axis: usize,
+    lo: f64,
+    hi: f64,
+}
+
+impl Slab {
+    /// Whether `p` lies strictly inside.
+    pub(super) fn contains(&self, p: DVec3) -> bool {
+        self.lo < p[self.axis] && p[self.axis] < self.hi
+    }
+
+    /// Whether collapsing `h` with placement `p` keeps every changed face inside: `p` and every
+    /// vertex around both endpoints are inside.
+    pub(super) fn holds_collapse(&self, mesh: &Mesh, h: HalfedgeId, p: DVec3) -> bool {
+        self.contains(p)
+            && [mesh.tail(h), mesh.head(h)].into_iter().all(|v| {
+                self.contains(mesh.position(v))
+                    && mesh
+                        .outgoing(v)
+                        .all(|o| self.contains(mesh.position(mesh.head(o))))
+            })
+    }
+}
+
+/// Decimates `mesh` to exactly `target_faces` faces with the promises of [`decimate`], using two
+/// threads for large meshes (see the module doc); small meshes and small reductions go straight
+/// to [`decimate`].
+///
+/// The mesh is rebuilt between the phases, so face and edge ids do not follow the input and
+/// `stats.remap` is `None` when the split ran; callers that keep per-element data in step use
+/// [`super::decimate_with`].
+pub fn decimate_in_parallel(
+    mesh: &mut Mesh,
+    target_faces: usize,
+    options: &DecimateOptions,
+) -> Result<DecimateStats, DecimateError> {
+    let initial = mesh.n_faces();
+    if let Some(noop) = check_request(mesh, target_faces, options)? {
+        return Ok(noop);
+    }
+    let goal = 2 * target_faces;
+    let large = initial >= MIN_FACES_TO_SPLIT && goal < initial / 2;
+    let Some((low, high)) = cutting_slabs(mesh).filter(|_| large) else {
+        return decimate(mesh, target_faces, options);
+    };
+    let (a, b) = rayon::join(
+        || decimate_side(mesh, low, goal, options),
+        || decimate_side(mesh, high, goal, options),
+    );
+    let Some(mut merged) = merge(&a.mesh, low, &b.mesh, high) else {
+        // Unreachable by the module doc's argument; keep the promise with one thread anyway.
+        debug_assert!(false, "merging the two decimated halves failed");
+        return decimate(mesh, target_faces, options);
+    };
+    // On `BudgetNotReached` the caller gets the closest mesh, as from `decimate`.
+    let result = decimate(&mut merged, target_faces, options);
+    *mesh = merged;
+    let mut stats = result?;
+    stats.initial_faces = initial;
+    stats.collapses += a.collapses + b.collapses;
+    stats.vetoes.add(&a.vetoes);
+    stats.vetoes.add(&b.vetoes);
+    stats.passes += a.passes.max(b.passes);
+    stats.max_cost = stats.max_cost.max(a.max_cost).max(b.max_cost);
+    stats.remap = None;
+    Ok(stats)
+}
+
+/// The low and high slabs of the module doc: the cut is the median vertex coordinate along the
+/// longest axis of the bounding box, the band half-width the longest edge. `None` for an empty
+/// or non-finite mesh.
+fn cutting_slabs(mesh: &Mesh) -> Option<(Slab, Slab)> {
+    let points: Vec<DVec3> = mesh.vertices().map(|v| mesh.position(v)).collect();
+    let (min, max) = points
+        .iter()
+        .fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), &p| {
+            (lo.min(p), hi.max(p))
+        });
+    let extent = max - min;
+    if !extent.is_finite() {
+        return None;
+    }
+    let axis = (0..3)
+        .max_by(|&a, &b| extent[a].total_cmp(&extent[b]))
+        .unwrap_or(0);
+    let mut coords: Vec<f64> = points.iter().map(|p| p[axis]).collect();
+    let mid = coords.len() / 2;
+    let (_, &mut c, _) = coords.select_nth_unstable_by(mid, f64::total_cmp);
+    let m = mesh
+        .edges()
+        .map(|e| mesh.edge_length(e))
+        .fold(0.0, f64::max);
+    Some((
+        Slab {
+            axis,
+            lo: f64::NEG_INFINITY,
+            hi: c - m,
+        },
+        Slab {
+            axis,
+            lo: c + m,
+            hi: f64::INFINITY,
+        },
+    ))
+}
+
+/// A copy of the mesh with one side decimated, and what that took.
+struct Side {
+    mesh: Mesh,
+    collapses: usize,
+    vetoes: VetoCounts,
+    passes: usize,
+    max_cost: f64,
+}
+
+/// Decimates, in a copy of `mesh`, the faces with a corner in `slab` to their share of `goal`
+/// faces (one heap pass at the first quality bound; whatever the vetoes leave is for the
+/// sequential phase).
+fn decimate_side(mesh: &Mesh, slab: Slab, goal: usize, options: &DecimateOptions) -> Side {
+    let mut copy = mesh.clone();
+    let total = copy.n_faces();
+    let inside = copy
+        .faces()
+        .filter(|&f| {
+            copy.face_vertices(f)
+                .iter()
+                .any(|&v| slab.contains(copy.position(v)))
+        })
+        .count();
+    let share = (goal as f64 * inside as f64 / total as f64) as usize;
+    let stop = total - inside.saturating_sub(share);
+    let mut run = Decimator::new(&mut copy, options, |_| {});
+    run.region = Some(slab);
+    let vetoes = run.pass(stop, options.quality_bounds[0]);
+    let (collapses, passes, max_cost) = (run.collapses, run.passes, run.max_cost);
+    drop(run);
+    Side {
+        mesh: copy,
+        collapses,
+        vetoes,
+        passes,
+        max_cost,
+    }
+}
+
+/// The merged mesh of the module doc: faces of `low_mesh` with a corner in `low` or only band
+/// corners, and faces of `high_mesh` with a corner in `high`, with the vertices they use
+/// renumbered in id order. `None` if that is not a closed manifold (never, by the module doc).
+fn merge(low_mesh: &Mesh, low: Slab, high_mesh: &Mesh, high: Slab) -> Option<Mesh> {
+    let capacity = low_mesh.vertex_capacity();
+    let mut position = vec![None; capacity];
+    let mut faces: Vec<[u32; 3]> = Vec::new();
+    for (mesh, own, other) in [(low_mesh, low, high), (high_mesh, high, low)] {
+        let is_low_copy = own == low;
+        for f in mesh.faces() {
+            let corners = mesh.face_vertices(f);
+            let points = corners.map(|v| mesh.position(v));
+            let mine = points.iter().any(|&p| own.contains(p));
+            let band_only = !mine && !points.iter().any(|&p| other.contains(p));
+            if mine || (band_only && is_low_copy) {
+                for (v, p) in corners.iter().zip(points) {
+                    position[v.index()] = Some(p);
+                }
+                faces.push(corners.map(|v| v.raw()));
+            }
+        }
+    }
+    let mut new_id = vec![u32::MAX; capacity];
+    let mut positions = Vec::new();
+    for (v, p) in position.iter().enumerate() {
+        if let Some(p) = p {
+            new_id[v] = positions.len() as u32;
+            positions.push(*p);
+        }
+    }
+    let triangles: Vec<[u32; 3]> = faces
+        .iter()
+        .map(|t| t.map(|v| new_id[v as usize]))
+        .collect();
+    Mesh::from_triangles(positions, &triangles).ok()
+}
