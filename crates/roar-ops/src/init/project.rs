@@ -293,10 +293,16 @@ pub(crate) fn project_surface(
     // 90° pay for the two normalizations, and the answer is the same as always normalizing.
     let dihedral_fast_path = params.min_dihedral_dot < -1e-9;
 
-    // Whether moving `v` to `candidate` keeps every incident triangle unfolded.
+    // Whether moving `v` to `candidate` keeps every incident triangle unfolded. The cross
+    // products of the incident faces are computed once and reused for the dihedral tests, where
+    // two of each face's three neighbours are incident faces too (a voxel-surface vertex has at
+    // most 24 incident faces; any beyond `CACHED` would simply be recomputed).
+    const CACHED: usize = 24;
     let acceptable = |positions: &[DVec3], v: usize, candidate: DVec3| -> bool {
         let (s, e) = (adj.face_start[v] as usize, adj.face_start[v + 1] as usize);
-        adj.faces[s..e].iter().all(|&f| {
+        let faces = &adj.faces[s..e];
+        let mut crosses = [DVec3::ZERO; CACHED];
+        for (i, &f) in faces.iter().enumerate() {
             let nrm = moved_cross(positions, f as usize, v, candidate);
             let len = nrm.length();
             if len < min_double_area
@@ -304,16 +310,31 @@ pub(crate) fn project_surface(
             {
                 return false;
             }
-            // No fold across the face's edges (dihedral angle kept below about 120°).
+            if i < CACHED {
+                crosses[i] = nrm;
+            }
+        }
+        // The faces are sorted, so an incident neighbour is found by binary search.
+        let cross_of = |g: u32| match faces.binary_search(&g) {
+            Ok(j) if j < CACHED => crosses[j],
+            _ => moved_cross(positions, g as usize, v, candidate),
+        };
+        // No fold across the faces' edges (dihedral angle kept below about 120°).
+        faces.iter().enumerate().all(|(i, &f)| {
+            let nrm = if i < CACHED {
+                crosses[i]
+            } else {
+                moved_cross(positions, f as usize, v, candidate)
+            };
             across[f as usize].iter().all(|&g| {
                 if g == u32::MAX {
                     return true;
                 }
-                let other = moved_cross(positions, g as usize, v, candidate);
+                let other = cross_of(g);
                 if dihedral_fast_path && nrm.dot(other) >= 0.0 {
                     return true;
                 }
-                (nrm / len).dot(other.normalize_or_zero()) > params.min_dihedral_dot
+                (nrm / nrm.length()).dot(other.normalize_or_zero()) > params.min_dihedral_dot
             })
         })
     };
