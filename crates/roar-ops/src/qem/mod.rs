@@ -256,7 +256,7 @@ pub fn decimate_with(
     if let Some(noop) = check_request(mesh, target_faces, options)? {
         return Ok(noop);
     }
-    let mut run = Decimator::new(mesh, options, on_collapse);
+    let mut run = Decimator::new(mesh, options, None, on_collapse);
     let mut last_pass = VetoCounts::default();
     let mut bound_used = options.quality_bounds[0];
     'bounds: for &bound in &options.quality_bounds {
@@ -384,9 +384,13 @@ struct Decimator<'m, F: FnMut(&Collapse)> {
     targets: Vec<DVec3>,
     heap: EdgeHeap,
     grid: Option<FaceGrid>,
+    /// Faces in the grid when it was last rebuilt, and now (it is rebuilt with larger cells
+    /// when half of them are gone).
     grid_faces: usize,
-    /// When set, only collapses whose star and placement lie inside this slab are made
-    /// (module `split`).
+    grid_live: usize,
+    /// When set, only collapses whose star and placement lie inside this slab are made, and the
+    /// grid holds only the faces with a corner inside (module `split`: no other face can meet
+    /// a face such a collapse creates).
     region: Option<split::Slab>,
     /// Scratch: the corners (before the collapse) of the fan of the collapse being checked.
     fan: Vec<[VertexId; 3]>,
@@ -412,7 +416,12 @@ fn face_corners_and_box(mesh: &Mesh, f: FaceId) -> ([u32; 3], Aabb) {
 }
 
 impl<'m, F: FnMut(&Collapse)> Decimator<'m, F> {
-    fn new(mesh: &'m mut Mesh, options: &'m DecimateOptions, on_collapse: F) -> Self {
+    fn new(
+        mesh: &'m mut Mesh,
+        options: &'m DecimateOptions,
+        region: Option<split::Slab>,
+        on_collapse: F,
+    ) -> Self {
         let mut quadrics = vec![Quadric::default(); mesh.vertex_capacity()];
         for f in mesh.faces() {
             let cross = mesh.face_cross(f);
@@ -434,7 +443,8 @@ impl<'m, F: FnMut(&Collapse)> Decimator<'m, F> {
             quadrics,
             grid: None,
             grid_faces: 0,
-            region: None,
+            grid_live: 0,
+            region,
             fan: Vec::new(),
             fan_scratch: Vec::new(),
             near_scratch: Vec::new(),
@@ -450,11 +460,15 @@ impl<'m, F: FnMut(&Collapse)> Decimator<'m, F> {
         d
     }
 
-    /// Rebuilds the face grid with cells of twice the current mean edge length.
+    /// Rebuilds the face grid with cells of twice the current mean edge length (of the faces
+    /// it holds: all, or those with a corner in the region).
     fn rebuild_grid(&mut self) {
         let mesh = &*self.mesh;
+        let region = self.region;
+        let inside = |v: VertexId| region.is_none_or(|slab| slab.contains(mesh.position(v)));
         let (sum, n) = mesh
             .edges()
+            .filter(|&e| mesh.edge_vertices(e).into_iter().any(inside))
             .fold((0.0, 0usize), |(s, n), e| (s + mesh.edge_length(e), n + 1));
         let mean = if n > 0 { sum / n as f64 } else { 1.0 };
         let cell = if mean > 0.0 && mean.is_finite() {
@@ -462,13 +476,18 @@ impl<'m, F: FnMut(&Collapse)> Decimator<'m, F> {
         } else {
             1.0
         };
-        let mut grid = FaceGrid::new(cell, mesh.face_capacity(), mesh.n_faces());
-        for f in mesh.faces() {
+        let faces: Vec<FaceId> = mesh
+            .faces()
+            .filter(|&f| mesh.face_vertices(f).into_iter().any(inside))
+            .collect();
+        let mut grid = FaceGrid::new(cell, mesh.face_capacity(), faces.len());
+        for &f in &faces {
             let (corners, bx) = face_corners_and_box(mesh, f);
             grid.insert(f.raw(), corners, &bx);
         }
         self.grid = Some(grid);
-        self.grid_faces = mesh.n_faces();
+        self.grid_faces = faces.len();
+        self.grid_live = faces.len();
     }
 
     /// Cost and placement of collapsing `e` under the current quadrics; records the placement.
@@ -676,6 +695,8 @@ impl<'m, F: FnMut(&Collapse)> Decimator<'m, F> {
             self.heap.remove(e.raw());
         }
         if let Some(grid) = self.grid.as_mut() {
+            // The removed faces held the collapsed edge, so they were in the grid.
+            self.grid_live -= c.removed_faces.len();
             for f in c.removed_faces {
                 grid.remove(f.raw());
             }
@@ -695,7 +716,7 @@ impl<'m, F: FnMut(&Collapse)> Decimator<'m, F> {
                 break;
             }
         }
-        if self.grid.is_some() && 2 * self.mesh.n_faces() < self.grid_faces {
+        if self.grid.is_some() && 2 * self.grid_live < self.grid_faces {
             self.rebuild_grid();
         }
     }

@@ -25,6 +25,11 @@
 //! created. The sequential [`decimate`] then reaches the exact target from the merged mesh with
 //! the usual promises.
 //!
+//! The same argument lets each copy's intersection grid hold only the faces with a corner on its
+//! side: a face without one lies in the other closed half-space, where no face the copy's
+//! collapses create can reach it. (Without that, the grid also held the other half and was never
+//! rebuilt with coarser cells, since the copy's face count never halves.)
+//!
 //! Each side is decimated to its share of twice the target, so the last halving (and the band)
 //! is done in the global cheapest-first order. The answer does not depend on the thread count.
 
@@ -172,8 +177,7 @@ fn decimate_side(mesh: &Mesh, slab: Slab, goal: usize, options: &DecimateOptions
         .count();
     let share = (goal as f64 * inside as f64 / total as f64) as usize;
     let stop = total - inside.saturating_sub(share);
-    let mut run = Decimator::new(&mut copy, options, |_| {});
-    run.region = Some(slab);
+    let mut run = Decimator::new(&mut copy, options, Some(slab), |_| {});
     let vetoes = run.pass(stop, options.quality_bounds[0]);
     let (collapses, passes, max_cost) = (run.collapses, run.passes, run.max_cost);
     drop(run);
