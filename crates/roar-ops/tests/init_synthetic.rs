@@ -310,3 +310,25 @@ fn torus_soup_keeps_genus_one() {
     );
     assert_eq!(assert_valid(&out), (1, 0));
 }
+
+/// The projection sweeps two halves of the surface at once (and the decimation of large inits
+/// runs two halves at once): the result must not depend on the thread count.
+#[test]
+fn init_is_the_same_on_one_thread_and_on_two() {
+    let mut soup = box_soup(DVec3::ZERO, DVec3::new(2.0, 1.0, 1.0));
+    append(
+        &mut soup,
+        &box_soup(DVec3::new(0.5, 0.3, 0.2), DVec3::new(1.7, 1.4, 0.8)),
+    );
+    let run = |threads: usize| {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap()
+            .install(|| init(&soup, 48))
+    };
+    let (one, two) = (run(1), run(2));
+    assert_valid(&two);
+    assert!(two.stats.rejected_moves < two.positions.len());
+    assert_eq!(one, two);
+}

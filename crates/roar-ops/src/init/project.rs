@@ -18,7 +18,7 @@
 //! proved: the tests count self-intersections by brute force on small cases.
 
 use super::grid::{EXTERIOR, Grid, SOLID};
-use super::surface::VoxelSurface;
+use super::surface::{Quad, VoxelSurface};
 use glam::DVec3;
 use rayon::prelude::*;
 
@@ -241,12 +241,31 @@ fn refresh_targets(
 }
 
 /// Moves the surface toward the target (closest-point function), obeying the non-crossing rule
-/// and the fold guard of the module doc. Deterministic: closest points are computed in parallel,
-/// moves are applied sequentially in vertex order.
+/// and the fold guard of the module doc. Deterministic and independent of the thread count:
+/// closest points are computed in parallel, and each sweep of moves runs in vertex order over
+/// the two halves of [`Halves`] at the same time, then over the band between them.
 pub(crate) fn project_surface(
     grid: &Grid,
     state: &[u8],
     surface: &mut VoxelSurface,
+    closest: &Closest,
+    params: &ProjectParams,
+) -> ProjectCounts {
+    let halves = Halves::of(grid, &surface.corners);
+    let mut ordered = relabelled(surface, &halves.order);
+    let counts = project_ordered(grid, state, &mut ordered, &halves, closest, params);
+    for (new, &old) in halves.order.iter().enumerate() {
+        surface.positions[old as usize] = ordered.positions[new];
+    }
+    counts
+}
+
+/// [`project_surface`] on a surface whose vertices are numbered low half, band, high half.
+fn project_ordered(
+    grid: &Grid,
+    state: &[u8],
+    surface: &mut VoxelSurface,
+    halves: &Halves,
     closest: &Closest,
     params: &ProjectParams,
 ) -> ProjectCounts {
@@ -277,12 +296,12 @@ pub(crate) fn project_surface(
     let across = faces_across_edges(triangles, &adj);
     // The cross product (twice the area, along the normal) of face `f` with `v` moved to
     // `candidate`.
-    let moved_cross = |positions: &[DVec3], f: usize, v: usize, candidate: DVec3| -> DVec3 {
+    let moved_cross = |positions: &View, f: usize, v: usize, candidate: DVec3| -> DVec3 {
         let p = triangles[f].map(|i| {
             if i as usize == v {
                 candidate
             } else {
-                positions[i as usize]
+                positions.get(i as usize)
             }
         });
         (p[1] - p[0]).cross(p[2] - p[0])
@@ -298,7 +317,7 @@ pub(crate) fn project_surface(
     // two of each face's three neighbours are incident faces too (a voxel-surface vertex has at
     // most 24 incident faces; any beyond `CACHED` would simply be recomputed).
     const CACHED: usize = 24;
-    let acceptable = |positions: &[DVec3], v: usize, candidate: DVec3| -> bool {
+    let acceptable = |positions: &View, v: usize, candidate: DVec3| -> bool {
         let (s, e) = (adj.face_start[v] as usize, adj.face_start[v + 1] as usize);
         let faces = &adj.faces[s..e];
         let mut crosses = [DVec3::ZERO; CACHED];
@@ -347,15 +366,49 @@ pub(crate) fn project_surface(
             p
         }
     };
-    let try_move = |positions: &mut [DVec3], v: usize, delta: DVec3| -> bool {
-        for scale in [1.0, 0.5, 0.25] {
-            let candidate = clamp_to_ball(v, positions[v] + delta * scale);
-            if acceptable(positions, v, candidate) {
-                positions[v] = candidate;
-                return true;
-            }
+    // The first of the shortened candidate moves that keeps the surface unfolded.
+    let try_move = |positions: &View, v: usize, delta: DVec3| -> Option<DVec3> {
+        let here = positions.get(v);
+        [1.0, 0.5, 0.25]
+            .into_iter()
+            .map(|scale| clamp_to_ball(v, here + delta * scale))
+            .find(|&candidate| acceptable(positions, v, candidate))
+    };
+    let max_step = params.step * h;
+    let toward_target = |positions: &View, targets: &[Option<DVec3>], v: usize| {
+        let target = targets[v]?;
+        let mut delta = target - positions.get(v);
+        if delta.length() > max_step {
+            delta *= max_step / delta.length();
         }
-        false
+        Some(try_move(positions, v, delta).ok_or(()))
+    };
+    // Light tangential relaxation: move toward the 1-ring centroid within the tangent plane.
+    let relaxed = |positions: &View, v: usize| -> Option<DVec3> {
+        let (s, e) = (
+            adj.neighbour_start[v] as usize,
+            adj.neighbour_start[v + 1] as usize,
+        );
+        if s == e {
+            return None;
+        }
+        let centroid = adj.neighbours[s..e]
+            .iter()
+            .map(|&u| positions.get(u as usize))
+            .sum::<DVec3>()
+            / (e - s) as f64;
+        let (fs, fe) = (adj.face_start[v] as usize, adj.face_start[v + 1] as usize);
+        let normal = adj.faces[fs..fe]
+            .iter()
+            .map(|&f| {
+                let t = triangles[f as usize].map(|i| positions.get(i as usize));
+                (t[1] - t[0]).cross(t[2] - t[0])
+            })
+            .sum::<DVec3>()
+            .normalize_or_zero();
+        let mut delta = centroid - positions.get(v);
+        delta -= normal * normal.dot(delta);
+        try_move(positions, v, delta * params.relax_weight)
     };
 
     let positions = &mut surface.positions;
@@ -365,46 +418,9 @@ pub(crate) fn project_surface(
     let slack = 1e-9 * h;
     for round in 0..params.rounds {
         refresh_targets(positions, closest, slack, &mut targets, &mut queried_at);
-        for v in 0..n {
-            let Some(target) = targets[v] else { continue };
-            let mut delta = target - positions[v];
-            let max_step = params.step * h;
-            if delta.length() > max_step {
-                delta *= max_step / delta.length();
-            }
-            if !try_move(positions, v, delta) {
-                counts.rejected_moves += 1;
-            }
-        }
-        if round + 1 == params.rounds || params.relax_weight <= 0.0 {
-            continue;
-        }
-        // Light tangential relaxation: move toward the 1-ring centroid within the tangent plane.
-        for v in 0..n {
-            let (s, e) = (
-                adj.neighbour_start[v] as usize,
-                adj.neighbour_start[v + 1] as usize,
-            );
-            if s == e {
-                continue;
-            }
-            let centroid = adj.neighbours[s..e]
-                .iter()
-                .map(|&u| positions[u as usize])
-                .sum::<DVec3>()
-                / (e - s) as f64;
-            let (fs, fe) = (adj.face_start[v] as usize, adj.face_start[v + 1] as usize);
-            let normal = adj.faces[fs..fe]
-                .iter()
-                .map(|&f| {
-                    let t = triangles[f as usize].map(|i| positions[i as usize]);
-                    (t[1] - t[0]).cross(t[2] - t[0])
-                })
-                .sum::<DVec3>()
-                .normalize_or_zero();
-            let mut delta = centroid - positions[v];
-            delta -= normal * normal.dot(delta);
-            try_move(positions, v, delta * params.relax_weight);
+        counts.rejected_moves += halves.sweep(positions, |p, v| toward_target(p, &targets, v));
+        if round + 1 < params.rounds && params.relax_weight > 0.0 {
+            halves.sweep(positions, |p, v| relaxed(p, v).map(Ok));
         }
     }
     refresh_targets(positions, closest, slack, &mut targets, &mut queried_at);
@@ -416,4 +432,138 @@ pub(crate) fn project_surface(
     counts.mean_distance = distances.iter().sum::<f64>() / n as f64;
     counts.max_distance = distances.iter().copied().fold(0.0, f64::max);
     counts
+}
+
+/// The vertices split by their grid corner along the longest grid axis: a low half, a band of 5
+/// corner layers around the middle, and a high half. `order` lists them in that order (new id →
+/// old id), each part in vertex order; [`project_ordered`] works on a surface renumbered so.
+///
+/// Moving a vertex reads only the vertices of the faces around it and of the faces across their
+/// edges, whose corners lie within 2 grid steps of its own (one vertex per corner, faces are
+/// halves of unit squares). So a low vertex (3 or more layers below the middle) never reads a
+/// high one, and the reverse: the two halves can be swept at the same time, each in vertex
+/// order, and every vertex sees what one sequential sweep over the low half, the high half and
+/// then the band would show it.
+struct Halves {
+    order: Vec<u32>,
+    low: usize,
+    band: usize,
+}
+
+impl Halves {
+    fn of(grid: &Grid, corners: &[[usize; 3]]) -> Halves {
+        let axis = (0..3).max_by_key(|&a| grid.dims[a]).unwrap_or(0);
+        let mid = grid.dims[axis] / 2;
+        let part = |c: &[usize; 3]| {
+            if c[axis] + 2 < mid {
+                0
+            } else if c[axis] > mid + 2 {
+                2
+            } else {
+                1
+            }
+        };
+        let mut order: Vec<u32> = (0..corners.len() as u32).collect();
+        order.sort_by_key(|&v| part(&corners[v as usize]));
+        let count = |p| corners.iter().filter(|c| part(c) == p).count();
+        Halves {
+            order,
+            low: count(0),
+            band: count(1),
+        }
+    }
+
+    /// One sweep of `step` over every vertex (numbered as in `order`): `step(positions, v)` is
+    /// `None` (no move wanted), `Some(Ok(p))` (move to `p`) or `Some(Err(()))` (a move was
+    /// wanted but rejected). Returns the number of rejected moves.
+    fn sweep(
+        &self,
+        positions: &mut [DVec3],
+        step: impl Fn(&View, usize) -> Option<Result<DVec3, ()>> + Sync,
+    ) -> usize {
+        let run = |mut view: View, vertices: std::ops::Range<usize>| {
+            let mut rejected = 0;
+            for v in vertices {
+                match step(&view, v) {
+                    Some(Ok(p)) => view.set(v, p),
+                    Some(Err(())) => rejected += 1,
+                    None => {}
+                }
+            }
+            rejected
+        };
+        let n = positions.len();
+        let (low, rest) = positions.split_at_mut(self.low);
+        let (band, high) = rest.split_at_mut(self.band);
+        let (band, high_start) = (&*band, self.low + self.band);
+        let (in_low, in_high) = rayon::join(
+            || run(View::new(low, 0, band, self.low), 0..self.low),
+            || run(View::new(high, high_start, band, self.low), high_start..n),
+        );
+        let all = View::new(positions, 0, &[], 0);
+        in_low + in_high + run(all, self.low..high_start)
+    }
+}
+
+/// The positions one sweep of [`Halves::sweep`] may touch: the part it moves (`own`, ids from
+/// `own_start`) and the part it only reads (`other`, ids from `other_start`).
+struct View<'a> {
+    own: &'a mut [DVec3],
+    own_start: usize,
+    other: &'a [DVec3],
+    other_start: usize,
+}
+
+impl<'a> View<'a> {
+    fn new(own: &'a mut [DVec3], own_start: usize, other: &'a [DVec3], other_start: usize) -> Self {
+        View {
+            own,
+            own_start,
+            other,
+            other_start,
+        }
+    }
+
+    /// The position of vertex `v`, which must lie in one of the two parts (see [`Halves`]).
+    #[inline]
+    fn get(&self, v: usize) -> DVec3 {
+        match self.own.get(v.wrapping_sub(self.own_start)) {
+            Some(p) => *p,
+            None => self.other[v - self.other_start],
+        }
+    }
+
+    #[inline]
+    fn set(&mut self, v: usize, p: DVec3) {
+        self.own[v - self.own_start] = p;
+    }
+}
+
+/// `surface` with its vertices renumbered: new vertex `i` is old vertex `order[i]`.
+fn relabelled(surface: &VoxelSurface, order: &[u32]) -> VoxelSurface {
+    let mut new_id = vec![0u32; order.len()];
+    for (new, &old) in order.iter().enumerate() {
+        new_id[old as usize] = new as u32;
+    }
+    let quads = surface
+        .quads
+        .iter()
+        .map(|q| Quad {
+            vertices: q.vertices.map(|v| new_id[v as usize]),
+            ..*q
+        })
+        .collect();
+    VoxelSurface {
+        corners: order.iter().map(|&v| surface.corners[v as usize]).collect(),
+        positions: order
+            .iter()
+            .map(|&v| surface.positions[v as usize])
+            .collect(),
+        quads,
+        triangles: surface
+            .triangles
+            .iter()
+            .map(|t| t.map(|v| new_id[v as usize]))
+            .collect(),
+    }
 }
