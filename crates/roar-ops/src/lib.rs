@@ -15,6 +15,7 @@ pub mod optim;
 pub mod qem;
 pub mod qslim;
 pub mod select;
+pub mod slivers;
 pub mod smoothing;
 pub mod split_block;
 pub mod untangle;

@@ -113,6 +113,13 @@ pub struct ReconstructConfig {
     /// target. If the kept mesh intersects itself, the QEM output is kept (the report says so).
     /// Runs only when `iterations > 0`, so `--iterations 0` stays the plain init + QEM.
     pub polish_iterations: usize,
+    /// Last step: flip the edges of faces with aspect ratio `Q = R/(2r)` above this when both
+    /// faces of the edge get better, the two are nearly coplanar (0.95) and no intersection
+    /// appears (`roar_ops::slivers`; 0 = off). [INF] Not in the paper: the optimization and
+    /// the polish move vertices for the losses, and the final QEM bounds only the faces it
+    /// creates, so a few caps (one angle near 180°) reach the output. Runs only when
+    /// `iterations > 0`.
+    pub sliver_quality: f64,
     /// Write the closest mesh when the final QEM cannot reach the budget, instead of failing.
     pub best_effort: bool,
 }
@@ -155,6 +162,7 @@ impl Default for ReconstructConfig {
             guard_intersections: false,
             untangle_margin: 1e-6,
             polish_iterations: 20,
+            sliver_quality: 10.0,
             best_effort: false,
         }
     }
@@ -193,6 +201,12 @@ impl ReconstructConfig {
             return Err(format!(
                 "learning_rate = {} must be positive",
                 self.learning_rate
+            ));
+        }
+        if !(self.sliver_quality == 0.0 || self.sliver_quality >= 1.0) {
+            return Err(format!(
+                "sliver_quality = {} must be 0 (off) or at least 1",
+                self.sliver_quality
             ));
         }
         if self.init_resolution < 8 {

@@ -32,6 +32,7 @@ use roar_ops::flips::FlipOptions;
 use roar_ops::init::{InitError, InitOptions, InitialMeshOptions};
 use roar_ops::optim::{Optimizer, OptimizerOptions};
 use roar_ops::qem::{DecimateError, DecimateOptions, DecimateStats, decimate};
+use roar_ops::slivers::{SliverOptions, flip_slivers};
 use roar_ops::smoothing::{SmoothingOptions, TangentialSmoothing};
 use roar_ops::split_block::{FaceSplit, FaceSplitOptions, SplitThreshold};
 use roar_ops::untangle::{LimiterOptions, UntangleOptions, UntangleStats, limit_moves, untangle};
@@ -152,6 +153,9 @@ pub struct RunStats {
     /// Whether the polished mesh was kept (false: it intersected itself, or no polish ran; true
     /// also when its best state was the unpolished one).
     pub polish_kept: bool,
+    /// Sliver flips in the output (`sliver_quality`; 0 also when they were undone because the
+    /// written mesh would have intersected itself).
+    pub sliver_flips: usize,
 }
 
 /// One iteration of the optimize stage, as the report lists it.
@@ -350,6 +354,10 @@ impl Reconstruction {
             )?;
         }
         drop(loss);
+        if config.iterations > 0 && config.sliver_quality > 0.0 {
+            mesh = flip_slivers_if_clean(mesh, &target.normalization, &config, &mut stats);
+            clock.lap("sliver_flips");
+        }
 
         let (mut out_positions, out_triangles) = mesh.to_triangles();
         target.normalization.invert_all(&mut out_positions);
@@ -609,6 +617,34 @@ fn polish(
     clock.lap("polish_check");
     stats.polish_kept = clean;
     Ok(if clean { best } else { mesh })
+}
+
+/// The sliver flips of `roar_ops::slivers` on the final mesh, kept only if the result is free of
+/// self-intersections in the input's coordinates, where it will be written (the flips are
+/// checked exactly in the normalized ones; undoing the normalization rounds).
+fn flip_slivers_if_clean(
+    mesh: Mesh,
+    normalization: &Normalization,
+    config: &ReconstructConfig,
+    stats: &mut RunStats,
+) -> Mesh {
+    let mut flipped = mesh.clone();
+    let options = SliverOptions {
+        max_quality: config.sliver_quality,
+        ..SliverOptions::default()
+    };
+    let block = flip_slivers(&mut flipped, &options);
+    stats.sliver_flips = block.accepted;
+    if block.accepted == 0 {
+        return mesh;
+    }
+    let (mut positions, triangles) = flipped.to_triangles();
+    normalization.invert_all(&mut positions);
+    if self_intersecting_faces(&positions, &triangles).contains(&true) {
+        stats.sliver_flips = 0;
+        return mesh;
+    }
+    flipped
 }
 
 /// The triangles of a compact mesh (compacting it, and the optimizer with it, if needed).
