@@ -611,9 +611,7 @@ fn polish(
     let Some((_, best)) = best else {
         return Ok(mesh);
     };
-    let (mut positions, triangles) = best.to_triangles();
-    normalization.invert_all(&mut positions);
-    let clean = !self_intersecting_faces(&positions, &triangles).contains(&true);
+    let clean = clean_in_output_coordinates(&best, normalization);
     clock.lap("polish_check");
     stats.polish_kept = clean;
     Ok(if clean { best } else { mesh })
@@ -634,17 +632,20 @@ fn flip_slivers_if_clean(
         ..SliverOptions::default()
     };
     let block = flip_slivers(&mut flipped, &options);
+    if block.accepted == 0 || !clean_in_output_coordinates(&flipped, normalization) {
+        return mesh;
+    }
     stats.sliver_flips = block.accepted;
-    if block.accepted == 0 {
-        return mesh;
-    }
-    let (mut positions, triangles) = flipped.to_triangles();
-    normalization.invert_all(&mut positions);
-    if self_intersecting_faces(&positions, &triangles).contains(&true) {
-        stats.sliver_flips = 0;
-        return mesh;
-    }
     flipped
+}
+
+/// Whether `mesh`, with the normalization undone (as it will be written), is free of
+/// self-intersections: the exact checks ran in normalized coordinates, and undoing the
+/// normalization rounds.
+fn clean_in_output_coordinates(mesh: &Mesh, normalization: &Normalization) -> bool {
+    let (mut positions, triangles) = mesh.to_triangles();
+    normalization.invert_all(&mut positions);
+    !self_intersecting_faces(&positions, &triangles).contains(&true)
 }
 
 /// The triangles of a compact mesh (compacting it, and the optimizer with it, if needed).

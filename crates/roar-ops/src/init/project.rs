@@ -314,14 +314,17 @@ fn project_ordered(
 
     // Whether moving `v` to `candidate` keeps every incident triangle unfolded. The cross
     // products of the incident faces are computed once and reused for the dihedral tests, where
-    // two of each face's three neighbours are incident faces too (a voxel-surface vertex has at
-    // most 24 incident faces; any beyond `CACHED` would simply be recomputed).
-    const CACHED: usize = 24;
+    // two of each face's three neighbours are incident faces too. A grid corner lies on at most
+    // 12 boundary squares, each giving it at most 2 triangles, so 24 slots always suffice.
     let acceptable = |positions: &View, v: usize, candidate: DVec3| -> bool {
         let (s, e) = (adj.face_start[v] as usize, adj.face_start[v + 1] as usize);
         let faces = &adj.faces[s..e];
-        let mut crosses = [DVec3::ZERO; CACHED];
-        for (i, &f) in faces.iter().enumerate() {
+        debug_assert!(
+            faces.len() <= 24,
+            "a voxel-surface vertex has at most 24 faces"
+        );
+        let mut crosses = [DVec3::ZERO; 24];
+        for (cross, &f) in crosses.iter_mut().zip(faces) {
             let nrm = moved_cross(positions, f as usize, v, candidate);
             let len = nrm.length();
             if len < min_double_area
@@ -329,22 +332,15 @@ fn project_ordered(
             {
                 return false;
             }
-            if i < CACHED {
-                crosses[i] = nrm;
-            }
+            *cross = nrm;
         }
         // The faces are sorted, so an incident neighbour is found by binary search.
         let cross_of = |g: u32| match faces.binary_search(&g) {
-            Ok(j) if j < CACHED => crosses[j],
-            _ => moved_cross(positions, g as usize, v, candidate),
+            Ok(j) => crosses[j],
+            Err(_) => moved_cross(positions, g as usize, v, candidate),
         };
         // No fold across the faces' edges (dihedral angle kept below about 120°).
-        faces.iter().enumerate().all(|(i, &f)| {
-            let nrm = if i < CACHED {
-                crosses[i]
-            } else {
-                moved_cross(positions, f as usize, v, candidate)
-            };
+        crosses.iter().zip(faces).all(|(&nrm, &f)| {
             across[f as usize].iter().all(|&g| {
                 if g == u32::MAX {
                     return true;

@@ -44,7 +44,7 @@ use roar_mesh::{HalfedgeId, Mesh};
 const MIN_FACES_TO_SPLIT: usize = 50_000;
 
 /// An open slab `lo < p[axis] < hi`.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy)]
 pub(super) struct Slab {
     axis: usize,
     lo: f64,
@@ -197,14 +197,16 @@ fn merge(low_mesh: &Mesh, low: Slab, high_mesh: &Mesh, high: Slab) -> Option<Mes
     let capacity = low_mesh.vertex_capacity();
     let mut position = vec![None; capacity];
     let mut faces: Vec<[u32; 3]> = Vec::new();
-    for (mesh, own, other) in [(low_mesh, low, high), (high_mesh, high, low)] {
-        let is_low_copy = own == low;
+    // The band-only faces are the same in both copies; they are taken from the low one.
+    for (mesh, own, other, takes_band) in
+        [(low_mesh, low, high, true), (high_mesh, high, low, false)]
+    {
         for f in mesh.faces() {
             let corners = mesh.face_vertices(f);
             let points = corners.map(|v| mesh.position(v));
             let mine = points.iter().any(|&p| own.contains(p));
             let band_only = !mine && !points.iter().any(|&p| other.contains(p));
-            if mine || (band_only && is_low_copy) {
+            if mine || (band_only && takes_band) {
                 for (v, p) in corners.iter().zip(points) {
                     position[v.index()] = Some(p);
                 }
