@@ -156,6 +156,95 @@ fn blocked_budget_is_a_named_error_or_the_closest_mesh_with_best_effort() {
     assert_eq!(roar_mesh::spatial::count_intersecting_faces(&m), 0);
 }
 
+/// A closed box `1 × 0.6 × 0.3` whose six flat sides are `n × n` grids of squares, each cut into
+/// two right triangles (aspect ratio about 1.2).
+fn gridded_box(n: usize) -> Mesh {
+    let size = [1.0, 0.6, 0.3];
+    let mut index = std::collections::HashMap::new();
+    let mut positions = Vec::new();
+    let mut triangles = Vec::new();
+    let mut vertex = |p: [f64; 3]| -> u32 {
+        let key = p.map(|x| (x * 1e9).round() as i64);
+        *index.entry(key).or_insert_with(|| {
+            positions.push(glam::DVec3::from_array(p));
+            positions.len() as u32 - 1
+        })
+    };
+    for axis in 0..3 {
+        let (u, v) = ((axis + 1) % 3, (axis + 2) % 3);
+        for side in [0.0, 1.0] {
+            for i in 0..n {
+                for j in 0..n {
+                    let mut corner = |a: usize, b: usize| {
+                        let mut p = [0.0; 3];
+                        p[axis] = side * size[axis];
+                        p[u] = a as f64 / n as f64 * size[u];
+                        p[v] = b as f64 / n as f64 * size[v];
+                        vertex(p)
+                    };
+                    let q = [
+                        corner(i, j),
+                        corner(i + 1, j),
+                        corner(i + 1, j + 1),
+                        corner(i, j + 1),
+                    ];
+                    if side > 0.0 {
+                        triangles.extend([[q[0], q[1], q[2]], [q[0], q[2], q[3]]]);
+                    } else {
+                        triangles.extend([[q[0], q[2], q[1]], [q[0], q[3], q[2]]]);
+                    }
+                }
+            }
+        }
+    }
+    Mesh::from_triangles(positions, &triangles).expect("a closed box")
+}
+
+/// Median, 95th percentile and largest aspect ratio of the faces.
+fn aspect_percentiles(m: &Mesh) -> [f64; 3] {
+    let mut q: Vec<f64> = m
+        .faces()
+        .map(|f| roar_ops::qem::triangle_quality(m.face_vertices(f).map(|v| m.position(v))))
+        .collect();
+    q.sort_by(f64::total_cmp);
+    [q[q.len() / 2], q[q.len() * 95 / 100], q[q.len() - 1]]
+}
+
+#[test]
+fn planar_quadrics_and_the_quality_penalty_keep_flat_regions_well_shaped() {
+    // On flat sides every in-plane collapse has zero quadric error, so without the planar
+    // quadrics and the penalty only the hard bound steers the layout (measured: median, 95th
+    // percentile and worst aspect ratio 1.34, 6.2, 9.6; with them 1.16, 1.8, 2.7).
+    let boxed = gridded_box(24);
+    let plain = DecimateOptions {
+        quality_penalty_above: 0.0,
+        planar_weight: 0.0,
+        ..DecimateOptions::default()
+    };
+    let mut rough = boxed.clone();
+    decimate(&mut rough, 300, &plain).unwrap();
+    let smooth = decimate_and_check(&boxed, 300);
+    let [rough_median, rough_p95, rough_max] = aspect_percentiles(&rough);
+    let [median, p95, max] = aspect_percentiles(&smooth);
+    assert!(
+        median <= rough_median && p95 < 0.5 * rough_p95 && max < rough_max,
+        "aspect median, p95, max: {median}, {p95}, {max} with the defaults, \
+         {rough_median}, {rough_p95}, {rough_max} without"
+    );
+    // The box keeps its shape: every vertex stays on its surface, up to 1e-4 of its size (the
+    // planar terms, 1e-3 of the face planes' weight, pull vertices on creases and corners
+    // slightly off them: measured 2e-5 at worst).
+    for v in smooth.vertices() {
+        let p = smooth.position(v);
+        let off = [p.x, p.y, p.z]
+            .iter()
+            .zip([1.0, 0.6, 0.3])
+            .map(|(&x, s)| x.abs().min((x - s).abs()))
+            .fold(f64::INFINITY, f64::min);
+        assert!(off < 1e-4, "vertex {p} left the box's sides");
+    }
+}
+
 /// Two concentric spheres 0.5 % of the radius apart (two components, 2 × 81 920 faces): a
 /// collapse on either shell that moved a vertex by more than the gap would cross the other one.
 fn nested_shells() -> Mesh {
