@@ -119,6 +119,39 @@ fn faces_across_edges(triangles: &[[u32; 3]], adj: &Adjacency) -> Vec<[u32; 3]> 
         .collect()
 }
 
+/// An entry of [`across_slots`]: no face across the edge (a boundary edge).
+const NO_FACE: u8 = u8::MAX;
+/// An entry of [`across_slots`]: the face across the edge is not incident to the vertex, so its
+/// cross product is computed from the positions (which gives the same value for any face).
+const NOT_INCIDENT: u8 = u8::MAX - 1;
+
+/// For every vertex `v` and every face `f` around it (in the order of `adj.faces`), for each edge
+/// `k` of `f`: the position in `v`'s face list of the face across that edge when it is around
+/// `v` too, else [`NOT_INCIDENT`] or [`NO_FACE`]. Lets the fold guard find the cross product of
+/// an incident neighbour by one look-up instead of a binary search (a vertex has at most 24
+/// faces, so a position fits in a `u8` below the two markers).
+fn across_slots(adj: &Adjacency, across: &[[u32; 3]]) -> Vec<[u8; 3]> {
+    let mut slots = vec![[NO_FACE; 3]; adj.faces.len()];
+    for v in 0..adj.face_start.len() - 1 {
+        let (s, e) = (adj.face_start[v] as usize, adj.face_start[v + 1] as usize);
+        let faces = &adj.faces[s..e];
+        for (slot, &f) in slots[s..e].iter_mut().zip(faces) {
+            *slot = across[f as usize].map(|g| {
+                if g == u32::MAX {
+                    return NO_FACE;
+                }
+                // (Positions past the markers cannot occur; computing the cross product anew, as
+                // for a face not around `v`, would give the same value anyway.)
+                match faces.binary_search(&g) {
+                    Ok(j) if j < NOT_INCIDENT as usize => j as u8,
+                    _ => NOT_INCIDENT,
+                }
+            });
+        }
+    }
+    slots
+}
+
 /// Outward normal sign of the boundary square with min corner `q` and normal axis `a`, if it is a
 /// boundary square: `Some(+1)` when the solid is on the negative side.
 fn square_side(grid: &Grid, state: &[u8], q: [i64; 3], a: usize) -> Option<i8> {
@@ -356,6 +389,7 @@ fn project_ordered(
     let min_double_area = 1e-4 * h * h;
     let triangles = &surface.triangles;
     let across = faces_across_edges(triangles, &adj);
+    let across_slots = across_slots(&adj, &across);
     // The cross product (twice the area, along the normal) of face `f` with `v` moved to
     // `candidate`.
     let moved_cross = |positions: &View, f: usize, v: usize, candidate: DVec3| -> DVec3 {
@@ -396,24 +430,28 @@ fn project_ordered(
             }
             *cross = nrm;
         }
-        // The faces are sorted, so an incident neighbour is found by binary search.
-        let cross_of = |g: u32| match faces.binary_search(&g) {
-            Ok(j) => crosses[j],
-            Err(_) => moved_cross(positions, g as usize, v, candidate),
-        };
-        // No fold across the faces' edges (dihedral angle kept below about 120°).
-        crosses.iter().zip(faces).all(|(&nrm, &f)| {
-            across[f as usize].iter().all(|&g| {
-                if g == u32::MAX {
-                    return true;
-                }
-                let other = cross_of(g);
-                if dihedral_fast_path && nrm.dot(other) >= 0.0 {
-                    return true;
-                }
-                (nrm / nrm.length()).dot(other.normalize_or_zero()) > params.min_dihedral_dot
+        // No fold across the faces' edges (dihedral angle kept below about 120°). A face across
+        // is either incident too (its cross product is in `crosses`) or does not move.
+        let slots = &across_slots[s..e];
+        crosses
+            .iter()
+            .zip(faces)
+            .zip(slots)
+            .all(|((&nrm, &f), slot)| {
+                (0..3).all(|k| {
+                    let other = match slot[k] {
+                        NO_FACE => return true,
+                        NOT_INCIDENT => {
+                            moved_cross(positions, across[f as usize][k] as usize, v, candidate)
+                        }
+                        j => crosses[j as usize],
+                    };
+                    if dihedral_fast_path && nrm.dot(other) >= 0.0 {
+                        return true;
+                    }
+                    (nrm / nrm.length()).dot(other.normalize_or_zero()) > params.min_dihedral_dot
+                })
             })
-        })
     };
     let clamp_to_ball = |v: usize, p: DVec3| -> DVec3 {
         let d = p - rest[v];
