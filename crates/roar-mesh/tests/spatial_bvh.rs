@@ -49,6 +49,48 @@ fn brute_ray_t(
         .min_by(f64::total_cmp)
 }
 
+/// The certified search gives the bounded search's answer, a lower bound on the distance to every
+/// other face (checked by brute force), and lets a moved query be answered by its face alone
+/// exactly when the bound proves it.
+fn check_certificate(
+    bvh: &TriangleBvh,
+    positions: &[DVec3],
+    triangles: &[[u32; 3]],
+    p: DVec3,
+    radius: f64,
+    toward: DVec3,
+) {
+    let within = bvh.closest_point_within(p, radius);
+    let certified = bvh.closest_point_certified(p, radius);
+    assert_eq!(within, certified.map(|c| c.closest));
+    let Some(c) = certified else {
+        return;
+    };
+    assert_eq!(bvh.closest_point_on_face(p, c.closest.face), c.closest);
+    for (f, &t) in triangles.iter().enumerate() {
+        if f as u32 == c.closest.face {
+            continue;
+        }
+        let d2 = p.distance_squared(closest_point_on_triangle(p, corners(positions, t)).0);
+        assert!(
+            c.others_squared <= d2 * (1.0 + 1e-12),
+            "face {f} at {d2} is nearer than the bound {}",
+            c.others_squared
+        );
+    }
+    // Moves of several lengths towards another point: wherever the bound proves the face is
+    // still the nearest, the face's point is the fresh search's answer.
+    for s in [1e-3, 1e-2, 0.1, 0.5] {
+        let q = p + s * (toward - p);
+        let moved = q.distance(p);
+        let clear = c.others_squared.sqrt() - moved;
+        let on_face = bvh.closest_point_on_face(q, c.closest.face);
+        if on_face.distance_squared.sqrt() * (1.0 + 1e-9) < clear * (1.0 - 1e-9) {
+            assert_eq!(bvh.closest_point(q), Some(on_face), "moved by {moved}");
+        }
+    }
+}
+
 fn check_against_brute_force(
     bvh: &TriangleBvh,
     positions: &[DVec3],
@@ -78,6 +120,14 @@ fn check_against_brute_force(
         if let Some(w) = within {
             assert!((w.distance_squared - brute).abs() <= 1e-12 * (1.0 + brute));
         }
+        check_certificate(
+            bvh,
+            positions,
+            triangles,
+            p,
+            radius,
+            queries[(k + 1) % queries.len()],
+        );
 
         // A ray from the query towards the next query point (and a ray along an axis).
         let target = queries[(k + 1) % queries.len()];

@@ -33,6 +33,17 @@ pub struct ClosestPoint {
     pub barycentric: [f64; 3],
 }
 
+/// The answer of [`TriangleBvh::closest_point_certified`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CertifiedClosest {
+    /// The closest point (as [`TriangleBvh::closest_point_within`] gives it).
+    pub closest: ClosestPoint,
+    /// A lower bound on the squared distance from the query to every face of the tree other than
+    /// `closest.face` (`f64::INFINITY` when there is no other face). Computed with the same
+    /// floating-point distances as the search, so callers should keep a small relative margin.
+    pub others_squared: f64,
+}
+
 /// The nearest hit found by [`TriangleBvh::ray_cast`].
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct RayHit {
@@ -213,7 +224,7 @@ impl TriangleBvh {
     ///
     /// Output: `None` only for an empty tree. Ties in distance go to the smaller face index.
     pub fn closest_point(&self, p: DVec3) -> Option<ClosestPoint> {
-        self.closest_point_impl(p, f64::INFINITY)
+        self.closest_point_impl(p, f64::INFINITY).map(|c| c.closest)
     }
 
     /// Closest point on the surface to `p` if it lies within distance `max_distance` (inclusive).
@@ -221,20 +232,50 @@ impl TriangleBvh {
     /// Faster than [`TriangleBvh::closest_point`] for small radii, since farther nodes are
     /// never opened.
     pub fn closest_point_within(&self, p: DVec3, max_distance: f64) -> Option<ClosestPoint> {
+        self.closest_point_certified(p, max_distance)
+            .map(|c| c.closest)
+    }
+
+    /// [`TriangleBvh::closest_point_within`], together with a lower bound on the distance from
+    /// `p` to every *other* face of the tree, gathered for free during the search: the smallest
+    /// of the squared distances of the other faces it measured and of the boxes of the nodes it
+    /// did not open. A caller whose query point moves by `δ` knows that no other face comes
+    /// closer than `√others_squared − δ`, so while face `closest.face` stays closer than that,
+    /// [`TriangleBvh::closest_point_on_face`] gives the same answer as a new search.
+    pub fn closest_point_certified(&self, p: DVec3, max_distance: f64) -> Option<CertifiedClosest> {
         if max_distance.is_nan() || max_distance < 0.0 {
             return None;
         }
         self.closest_point_impl(p, max_distance * max_distance)
     }
 
-    fn closest_point_impl(&self, p: DVec3, limit_d2: f64) -> Option<ClosestPoint> {
+    /// The point of face `f` closest to `p`, computed exactly as the searches compute it for that
+    /// face (so it is bit-identical to their answer whenever they return `f`).
+    ///
+    /// # Panics
+    /// If `f` is not a face of the tree (index out of range of the build buffers).
+    pub fn closest_point_on_face(&self, p: DVec3, f: u32) -> ClosestPoint {
+        let (point, barycentric) = closest_point_on_triangle(p, self.corners(f));
+        ClosestPoint {
+            face: f,
+            point,
+            distance_squared: p.distance_squared(point),
+            barycentric,
+        }
+    }
+
+    fn closest_point_impl(&self, p: DVec3, limit_d2: f64) -> Option<CertifiedClosest> {
         let mut best: Option<ClosestPoint> = None;
         let mut best_d2 = limit_d2;
+        // The smallest squared distance of a face measured but not (or no longer) the best, and
+        // of a node box not opened: a lower bound for every face but the best.
+        let mut others_d2 = f64::INFINITY;
         let mut stack: Vec<(u32, f64)> = Vec::with_capacity(64);
         let root = self.nodes.first()?;
         stack.push((0, root.aabb.distance_squared(p)));
         while let Some((n, box_d2)) = stack.pop() {
             if box_d2 > best_d2 {
+                others_d2 = others_d2.min(box_d2);
                 continue;
             }
             let node = &self.nodes[n as usize];
@@ -247,6 +288,9 @@ impl TriangleBvh {
                         Some(b) => d2 < best_d2 || (d2 == best_d2 && f < b.face),
                     };
                     if better {
+                        if best.is_some() {
+                            others_d2 = others_d2.min(best_d2);
+                        }
                         best_d2 = d2;
                         best = Some(ClosestPoint {
                             face: f,
@@ -254,6 +298,8 @@ impl TriangleBvh {
                             distance_squared: d2,
                             barycentric,
                         });
+                    } else {
+                        others_d2 = others_d2.min(d2);
                     }
                 }
             } else {
@@ -269,13 +315,20 @@ impl TriangleBvh {
                 };
                 if far.1 <= best_d2 {
                     stack.push(far);
+                } else {
+                    others_d2 = others_d2.min(far.1);
                 }
                 if near.1 <= best_d2 {
                     stack.push(near);
+                } else {
+                    others_d2 = others_d2.min(near.1);
                 }
             }
         }
-        best
+        best.map(|closest| CertifiedClosest {
+            closest,
+            others_squared: others_d2,
+        })
     }
 
     /// Nearest hit of the ray `origin + t·dir` with `t ∈ (0, t_max]`.

@@ -28,7 +28,7 @@ pub mod tri_tri;
 pub mod winding;
 
 pub use aabb::Aabb;
-pub use bvh::{ClosestPoint, RayHit, TriangleBvh};
+pub use bvh::{CertifiedClosest, ClosestPoint, RayHit, TriangleBvh};
 pub use normalization::{Normalization, RIG_RADIUS};
 pub use point_triangle::{closest_point_on_triangle, ray_triangle};
 pub use projector::{Projector, SphereProjector};

@@ -220,8 +220,20 @@ pub fn watertight_init(
     let voxel = (max - min).max_element() / options.resolution.max(1) as f64;
     let (split_positions, split_triangles) = split_long_edges(&soup, 4.0 * voxel);
     let bvh = TriangleBvh::build(&split_positions, &split_triangles);
-    let closest = |p: DVec3, bound: f64| bvh.closest_point_within(p, bound).map(|c| c.point);
-    watertight_init_from(&soup, triangles.len(), options, &closest)
+    let nearest = |p: DVec3, bound: f64| {
+        bvh.closest_point_certified(p, bound)
+            .map(|c| project::Nearest {
+                point: c.closest.point,
+                face: c.closest.face,
+                others: c.others_squared.sqrt(),
+            })
+    };
+    let on_face = |p: DVec3, f: u32| bvh.closest_point_on_face(p, f).point;
+    let target = project::Target {
+        nearest: &nearest,
+        on_face: Some(&on_face),
+    };
+    watertight_init_from(&soup, triangles.len(), options, &target)
 }
 
 /// Most triangles [`split_long_edges`] produces; past it, long edges are left as they are.
@@ -280,8 +292,18 @@ pub fn watertight_init_with(
     closest: &(dyn Fn(DVec3) -> Option<DVec3> + Sync),
 ) -> Result<WatertightInit, InitError> {
     let soup = valid_triangles(positions, triangles)?;
-    let unbounded = |p: DVec3, _bound: f64| closest(p);
-    watertight_init_from(&soup, triangles.len(), options, &unbounded)
+    let unbounded = |p: DVec3, _bound: f64| {
+        closest(p).map(|point| project::Nearest {
+            point,
+            face: 0,
+            others: 0.0,
+        })
+    };
+    let target = project::Target {
+        nearest: &unbounded,
+        on_face: None,
+    };
+    watertight_init_from(&soup, triangles.len(), options, &target)
 }
 
 /// Checks indices and coordinates; returns the non-degenerate triangles (never empty).
@@ -350,7 +372,7 @@ fn watertight_init_from(
     soup: &[[DVec3; 3]],
     input_triangles: usize,
     options: &InitOptions,
-    closest: &project::Closest,
+    target: &project::Target,
 ) -> Result<WatertightInit, InitError> {
     check_options(options)?;
     let (min, max) = soup_bounds(soup);
@@ -385,7 +407,7 @@ fn watertight_init_from(
         min_normal_dot: options.min_normal_dot,
         min_dihedral_dot: options.min_dihedral_dot,
     };
-    let projection = project::project_surface(&grid, &state, &mut surface, closest, &params);
+    let projection = project::project_surface(&grid, &state, &mut surface, target, &params);
     let pieces = pieces::keep_large_pieces(
         &surface.positions,
         &surface.triangles,

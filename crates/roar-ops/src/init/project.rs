@@ -119,6 +119,39 @@ fn faces_across_edges(triangles: &[[u32; 3]], adj: &Adjacency) -> Vec<[u32; 3]> 
         .collect()
 }
 
+/// An entry of [`across_slots`]: no face across the edge (a boundary edge).
+const NO_FACE: u8 = u8::MAX;
+/// An entry of [`across_slots`]: the face across the edge is not incident to the vertex, so its
+/// cross product is computed from the positions (which gives the same value for any face).
+const NOT_INCIDENT: u8 = u8::MAX - 1;
+
+/// For every vertex `v` and every face `f` around it (in the order of `adj.faces`), for each edge
+/// `k` of `f`: the position in `v`'s face list of the face across that edge when it is around
+/// `v` too, else [`NOT_INCIDENT`] or [`NO_FACE`]. Lets the fold guard find the cross product of
+/// an incident neighbour by one look-up instead of a binary search (a vertex has at most 24
+/// faces, so a position fits in a `u8` below the two markers).
+fn across_slots(adj: &Adjacency, across: &[[u32; 3]]) -> Vec<[u8; 3]> {
+    let mut slots = vec![[NO_FACE; 3]; adj.faces.len()];
+    for v in 0..adj.face_start.len() - 1 {
+        let (s, e) = (adj.face_start[v] as usize, adj.face_start[v + 1] as usize);
+        let faces = &adj.faces[s..e];
+        for (slot, &f) in slots[s..e].iter_mut().zip(faces) {
+            *slot = across[f as usize].map(|g| {
+                if g == u32::MAX {
+                    return NO_FACE;
+                }
+                // (Positions past the markers cannot occur; computing the cross product anew, as
+                // for a face not around `v`, would give the same value anyway.)
+                match faces.binary_search(&g) {
+                    Ok(j) if j < NOT_INCIDENT as usize => j as u8,
+                    _ => NOT_INCIDENT,
+                }
+            });
+        }
+    }
+    slots
+}
+
 /// Outward normal sign of the boundary square with min corner `q` and normal axis `a`, if it is a
 /// boundary square: `Some(+1)` when the solid is on the negative side.
 fn square_side(grid: &Grid, state: &[u8], q: [i64; 3], a: usize) -> Option<i8> {
@@ -197,46 +230,108 @@ fn quad_clearances(grid: &Grid, state: &[u8], surface: &VoxelSurface, cap: usize
         .collect()
 }
 
-/// A closest-point query on the target: `closest(p, bound)` is the point of the target nearest
+/// A closest-point query on the target: `nearest(p, bound)` is the point of the target nearest
 /// to `p`, where `bound` is an upper bound on that distance (`f64::INFINITY` when unknown) which
 /// the query may use to prune. It must give the same point as without a bound whenever the
 /// nearest point lies within `bound`, and may give `None` otherwise.
-pub(crate) type Closest<'a> = dyn Fn(DVec3, f64) -> Option<DVec3> + Sync + 'a;
+pub(crate) type Closest<'a> = dyn Fn(DVec3, f64) -> Option<Nearest> + Sync + 'a;
 
-/// Brings `targets[v]` to the closest target point of `positions[v]` for every vertex, reusing
-/// the previous answer: a vertex that has not moved since `queried_at[v]` keeps its target (the
-/// same query would give the same point), and one that moved searches only within its distance
-/// to its old target (which lies on the target, so the nearest point is at least that close;
-/// enlarged by a relative 1e-9 and by `slack` against rounding, so that a vertex sitting on its
-/// target still gets a non-empty search). Exactly the points of fresh unbounded queries; the
-/// later rounds, where vertices move little, cost a half to a third of an unbounded round.
-fn refresh_targets(
-    positions: &[DVec3],
-    closest: &Closest,
-    slack: f64,
-    targets: &mut [Option<DVec3>],
-    queried_at: &mut [DVec3],
-) {
-    targets
+/// The point of one face of the target nearest to a query: `on_face(p, face)`, computed exactly
+/// as [`Closest`] computes it for that face.
+pub(crate) type OnFace<'a> = dyn Fn(DVec3, u32) -> DVec3 + Sync + 'a;
+
+/// The target as [`project_surface`] queries it.
+#[derive(Clone, Copy)]
+pub(crate) struct Target<'a> {
+    pub nearest: &'a Closest<'a>,
+    /// `None` when the target cannot evaluate one face (then every [`Nearest::others`] is 0).
+    pub on_face: Option<&'a OnFace<'a>>,
+}
+
+/// An answer of [`Closest`].
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Nearest {
+    /// The nearest point of the target.
+    pub point: DVec3,
+    /// The face of the target holding `point` (see [`Target::on_face`]).
+    pub face: u32,
+    /// A lower bound on the distance from the query to every other face of the target (0 when
+    /// nothing is known).
+    pub others: f64,
+}
+
+/// What [`refresh_targets`] remembers of a vertex: its target, where it was last queried, and
+/// the certificate of its last full search.
+#[derive(Clone, Copy, Debug)]
+struct TargetState {
+    target: Option<DVec3>,
+    /// The position the target belongs to (NaN before the first query).
+    queried_at: DVec3,
+    /// The position of the last full search, and its answer's face and `others`.
+    searched_at: DVec3,
+    face: u32,
+    others: f64,
+}
+
+impl TargetState {
+    const UNKNOWN: TargetState = TargetState {
+        target: None,
+        queried_at: DVec3::NAN,
+        searched_at: DVec3::NAN,
+        face: 0,
+        others: 0.0,
+    };
+}
+
+/// Brings every vertex's target to the closest target point of `positions[v]`, reusing the
+/// previous answers; exactly the points of fresh unbounded queries.
+///
+/// - A vertex that has not moved since it was queried keeps its target (the same query would
+///   give the same point).
+/// - A vertex that moved by `δ` since its last full search, which found face `f` and showed
+///   every other face to be at least `others` away, has every other face at least `others − δ`
+///   away now. If `f` is closer than that (with a relative 1e-9 and `slack` to spare against
+///   rounding), `f` is the unique nearest face and its nearest point is the answer, found with
+///   one point-triangle test and no search (most vertices in the later rounds, where they move
+///   little).
+/// - Otherwise it searches only within its distance to its old target (which lies on the
+///   target, so the nearest point is at least that close; enlarged by a relative 1e-9 and by
+///   `slack` against rounding, so that a vertex sitting on its target still gets a non-empty
+///   search).
+fn refresh_targets(positions: &[DVec3], target: &Target, slack: f64, states: &mut [TargetState]) {
+    states
         .par_iter_mut()
-        .zip(queried_at.par_iter_mut())
         .zip(positions.par_iter())
-        .for_each(|((target, at), &p)| {
-            if *at == p {
+        .for_each(|(state, &p)| {
+            if state.queried_at == p {
                 return;
             }
-            let bound = target.map_or(f64::INFINITY, |old| {
+            state.queried_at = p;
+            if let (Some(on_face), Some(_)) = (target.on_face, state.target) {
+                let clear = state.others - p.distance(state.searched_at);
+                if clear > 0.0 {
+                    let q = on_face(p, state.face);
+                    let d = p.distance(q);
+                    if d + d * 1e-9 + slack < clear * (1.0 - 1e-9) {
+                        state.target = Some(q);
+                        return;
+                    }
+                }
+            }
+            let bound = state.target.map_or(f64::INFINITY, |old| {
                 let d = p.distance(old);
                 d + d * 1e-9 + slack
             });
-            *target = closest(p, bound).or_else(|| {
+            let found = (target.nearest)(p, bound).or_else(|| {
                 if bound.is_finite() {
-                    closest(p, f64::INFINITY)
+                    (target.nearest)(p, f64::INFINITY)
                 } else {
                     None
                 }
             });
-            *at = p;
+            state.target = found.map(|n| n.point);
+            state.searched_at = p;
+            (state.face, state.others) = found.map_or((0, 0.0), |n| (n.face, n.others));
         });
 }
 
@@ -248,12 +343,12 @@ pub(crate) fn project_surface(
     grid: &Grid,
     state: &[u8],
     surface: &mut VoxelSurface,
-    closest: &Closest,
+    target: &Target,
     params: &ProjectParams,
 ) -> ProjectCounts {
     let halves = Halves::of(grid, &surface.corners);
     let mut ordered = relabelled(surface, &halves.order);
-    let counts = project_ordered(grid, state, &mut ordered, &halves, closest, params);
+    let counts = project_ordered(grid, state, &mut ordered, &halves, target, params);
     for (new, &old) in halves.order.iter().enumerate() {
         surface.positions[old as usize] = ordered.positions[new];
     }
@@ -266,7 +361,7 @@ fn project_ordered(
     state: &[u8],
     surface: &mut VoxelSurface,
     halves: &Halves,
-    closest: &Closest,
+    target: &Target,
     params: &ProjectParams,
 ) -> ProjectCounts {
     let n = surface.positions.len();
@@ -294,6 +389,7 @@ fn project_ordered(
     let min_double_area = 1e-4 * h * h;
     let triangles = &surface.triangles;
     let across = faces_across_edges(triangles, &adj);
+    let across_slots = across_slots(&adj, &across);
     // The cross product (twice the area, along the normal) of face `f` with `v` moved to
     // `candidate`.
     let moved_cross = |positions: &View, f: usize, v: usize, candidate: DVec3| -> DVec3 {
@@ -334,24 +430,28 @@ fn project_ordered(
             }
             *cross = nrm;
         }
-        // The faces are sorted, so an incident neighbour is found by binary search.
-        let cross_of = |g: u32| match faces.binary_search(&g) {
-            Ok(j) => crosses[j],
-            Err(_) => moved_cross(positions, g as usize, v, candidate),
-        };
-        // No fold across the faces' edges (dihedral angle kept below about 120°).
-        crosses.iter().zip(faces).all(|(&nrm, &f)| {
-            across[f as usize].iter().all(|&g| {
-                if g == u32::MAX {
-                    return true;
-                }
-                let other = cross_of(g);
-                if dihedral_fast_path && nrm.dot(other) >= 0.0 {
-                    return true;
-                }
-                (nrm / nrm.length()).dot(other.normalize_or_zero()) > params.min_dihedral_dot
+        // No fold across the faces' edges (dihedral angle kept below about 120°). A face across
+        // is either incident too (its cross product is in `crosses`) or does not move.
+        let slots = &across_slots[s..e];
+        crosses
+            .iter()
+            .zip(faces)
+            .zip(slots)
+            .all(|((&nrm, &f), slot)| {
+                (0..3).all(|k| {
+                    let other = match slot[k] {
+                        NO_FACE => return true,
+                        NOT_INCIDENT => {
+                            moved_cross(positions, across[f as usize][k] as usize, v, candidate)
+                        }
+                        j => crosses[j as usize],
+                    };
+                    if dihedral_fast_path && nrm.dot(other) >= 0.0 {
+                        return true;
+                    }
+                    (nrm / nrm.length()).dot(other.normalize_or_zero()) > params.min_dihedral_dot
+                })
             })
-        })
     };
     let clamp_to_ball = |v: usize, p: DVec3| -> DVec3 {
         let d = p - rest[v];
@@ -371,8 +471,8 @@ fn project_ordered(
             .find(|&candidate| acceptable(positions, v, candidate))
     };
     let max_step = params.step * h;
-    let toward_target = |positions: &View, targets: &[Option<DVec3>], v: usize| {
-        let target = targets[v]?;
+    let toward_target = |positions: &View, states: &[TargetState], v: usize| {
+        let target = states[v].target?;
         let mut delta = target - positions.get(v);
         if delta.length() > max_step {
             delta *= max_step / delta.length();
@@ -408,22 +508,21 @@ fn project_ordered(
     };
 
     let positions = &mut surface.positions;
-    let mut targets: Vec<Option<DVec3>> = vec![None; n];
     // NaN compares unequal to every position, so the first refresh queries every vertex.
-    let mut queried_at = vec![DVec3::NAN; n];
+    let mut states = vec![TargetState::UNKNOWN; n];
     let slack = 1e-9 * h;
     for round in 0..params.rounds {
-        refresh_targets(positions, closest, slack, &mut targets, &mut queried_at);
-        counts.rejected_moves += halves.sweep(positions, |p, v| toward_target(p, &targets, v));
+        refresh_targets(positions, target, slack, &mut states);
+        counts.rejected_moves += halves.sweep(positions, |p, v| toward_target(p, &states, v));
         if round + 1 < params.rounds && params.relax_weight > 0.0 {
             halves.sweep(positions, |p, v| relaxed(p, v).map(Ok));
         }
     }
-    refresh_targets(positions, closest, slack, &mut targets, &mut queried_at);
+    refresh_targets(positions, target, slack, &mut states);
     let distances: Vec<f64> = positions
         .iter()
-        .zip(&targets)
-        .map(|(p, t)| t.map_or(0.0, |q| (q - *p).length()))
+        .zip(&states)
+        .map(|(p, s)| s.target.map_or(0.0, |q| (q - *p).length()))
         .collect();
     counts.mean_distance = distances.iter().sum::<f64>() / n as f64;
     counts.max_distance = distances.iter().copied().fold(0.0, f64::max);
@@ -561,5 +660,64 @@ fn relabelled(surface: &VoxelSurface, order: &[u32]) -> VoxelSurface {
             .iter()
             .map(|t| t.map(|v| new_id[v as usize]))
             .collect(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rand::{Rng, SeedableRng};
+    use rand_chacha::ChaCha8Rng;
+    use roar_mesh::spatial::TriangleBvh;
+
+    /// Oracle: over random walks of the query points (small steps, so most refreshes take the
+    /// certified shortcut, and a few large jumps), every refresh gives exactly the points of
+    /// fresh unbounded searches.
+    #[test]
+    fn refreshed_targets_equal_fresh_searches() {
+        let mut rng = ChaCha8Rng::seed_from_u64(7);
+        let point = |rng: &mut ChaCha8Rng, r: f64| {
+            DVec3::new(
+                rng.random_range(-r..r),
+                rng.random_range(-r..r),
+                rng.random_range(-r..r),
+            )
+        };
+        let positions: Vec<DVec3> = (0..150).map(|_| point(&mut rng, 1.0)).collect();
+        let triangles: Vec<[u32; 3]> = (0..50).map(|f| [3 * f, 3 * f + 1, 3 * f + 2]).collect();
+        let bvh = TriangleBvh::build(&positions, &triangles);
+        let nearest = |p: DVec3, bound: f64| {
+            bvh.closest_point_certified(p, bound).map(|c| Nearest {
+                point: c.closest.point,
+                face: c.closest.face,
+                others: c.others_squared.sqrt(),
+            })
+        };
+        let on_face = |p: DVec3, f: u32| bvh.closest_point_on_face(p, f).point;
+        let target = Target {
+            nearest: &nearest,
+            on_face: Some(&on_face),
+        };
+        let mut queries: Vec<DVec3> = (0..400).map(|_| point(&mut rng, 1.5)).collect();
+        let mut states = vec![TargetState::UNKNOWN; queries.len()];
+        let mut shortcuts = 0;
+        for round in 0..30 {
+            let before: Vec<DVec3> = states.iter().map(|s| s.searched_at).collect();
+            refresh_targets(&queries, &target, 1e-12, &mut states);
+            for ((s, q), b) in states.iter().zip(&queries).zip(&before) {
+                assert_eq!(s.target, bvh.closest_point(*q).map(|c| c.point));
+                shortcuts += usize::from(s.searched_at == *b && *b != *q);
+            }
+            for (i, q) in queries.iter_mut().enumerate() {
+                let scale = if (i + round) % 37 == 0 { 1.0 } else { 0.01 };
+                if i % 5 != 0 {
+                    *q += point(&mut rng, scale);
+                }
+            }
+        }
+        assert!(
+            shortcuts > 1000,
+            "only {shortcuts} refreshes took the shortcut"
+        );
     }
 }

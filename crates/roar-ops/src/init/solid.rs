@@ -32,29 +32,40 @@ pub(crate) struct RepairCounts {
 /// (6-connectivity). Returns the state per voxel: `EXTERIOR` if reached, `SOLID` otherwise.
 pub(crate) fn flood_exterior(grid: &Grid, blocked: &[u8]) -> Vec<u8> {
     let mut state = vec![SOLID; grid.len()];
-    let mut stack = Vec::new();
-    for idx in 0..grid.len() {
-        if blocked[idx] == 0 && grid.on_border(grid.coords(idx)) {
-            state[idx] = EXTERIOR;
-            stack.push(idx);
+    // Each stack entry carries its voxel's coordinates, so no index is divided back into them
+    // (two integer divisions per voxel were a good part of the fill's time).
+    let mut stack: Vec<(usize, [usize; 3])> = Vec::new();
+    let [nx, ny, nz] = grid.dims;
+    for k in 0..nz {
+        for j in 0..ny {
+            for i in 0..nx {
+                let idx = grid.index(i, j, k);
+                if blocked[idx] == 0 && grid.on_border([i, j, k]) {
+                    state[idx] = EXTERIOR;
+                    stack.push((idx, [i, j, k]));
+                }
+            }
         }
     }
-    let strides = [1, grid.dims[0], grid.dims[0] * grid.dims[1]];
-    while let Some(idx) = stack.pop() {
-        let c = grid.coords(idx);
+    let strides = [1, nx, nx * ny];
+    while let Some((idx, c)) = stack.pop() {
         for a in 0..3 {
             if c[a] > 0 {
                 let n = idx - strides[a];
                 if blocked[n] == 0 && state[n] == SOLID {
                     state[n] = EXTERIOR;
-                    stack.push(n);
+                    let mut cn = c;
+                    cn[a] -= 1;
+                    stack.push((n, cn));
                 }
             }
             if c[a] + 1 < grid.dims[a] {
                 let n = idx + strides[a];
                 if blocked[n] == 0 && state[n] == SOLID {
                     state[n] = EXTERIOR;
-                    stack.push(n);
+                    let mut cn = c;
+                    cn[a] += 1;
+                    stack.push((n, cn));
                 }
             }
         }

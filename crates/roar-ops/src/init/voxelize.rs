@@ -55,6 +55,11 @@ pub(crate) fn is_degenerate(tri: [DVec3; 3]) -> bool {
 /// Marks (sets to 1) every voxel that one of the triangles touches. Triangles are given in world
 /// coordinates; the test runs in grid coordinates with the box inflated by 1e-9 voxel so that a
 /// triangle lying exactly on a voxel face marks both neighbours.
+///
+/// Along each row of voxels of a triangle's bounding box only the voxels near the triangle's
+/// plane are tested ([`row_near_plane`]); the others fail the exact test's plane axis anyway, so
+/// the marks are those of testing every voxel of the box. (A big triangle's box holds many
+/// times more voxels than its plane crosses.)
 pub(crate) fn mark_surface_voxels(grid: &Grid, triangles: &[[DVec3; 3]]) -> Vec<u8> {
     let mut marked = vec![0u8; grid.len()];
     let half = DVec3::splat(0.5 + 1e-9);
@@ -74,7 +79,10 @@ pub(crate) fn mark_surface_voxels(grid: &Grid, triangles: &[[DVec3; 3]]) -> Vec<
         }
         for k in range[2].0..=range[2].1 {
             for j in range[1].0..=range[1].1 {
-                for i in range[0].0..=range[0].1 {
+                let Some((i0, i1)) = row_near_plane(g, half, j, k, range[0]) else {
+                    continue;
+                };
+                for i in i0..=i1 {
                     let center = DVec3::new(i as f64 + 0.5, j as f64 + 0.5, k as f64 + 0.5);
                     if triangle_box_overlap(center, half, g) {
                         marked[grid.index(i, j, k)] = 1;
@@ -84,6 +92,41 @@ pub(crate) fn mark_surface_voxels(grid: &Grid, triangles: &[[DVec3; 3]]) -> Vec<
         }
     }
     marked
+}
+
+/// The voxels `i0..=i1` within `range` of the row `(·, j, k)` whose boxes (`center ± half`, in
+/// grid coordinates) may meet the plane of `tri`: every voxel of the row that
+/// [`triangle_box_overlap`] accepts is among them. `None` when there is none.
+///
+/// A box meets the plane `n·x = n·tri[0]` iff `|n·tri[0] − n·center| ≤ half·|n|`, which bounds the
+/// centre's `x` to an interval; it is widened by one voxel on each side, far more than the
+/// rounding of either computation. Planes nearly parallel to the row (`|n.x|` tiny against `|n|`)
+/// and (nearly) degenerate triangles, whose computed normals are rounding noise, keep the whole
+/// range.
+fn row_near_plane(
+    tri: [DVec3; 3],
+    half: DVec3,
+    j: usize,
+    k: usize,
+    range: (usize, usize),
+) -> Option<(usize, usize)> {
+    let (e0, e1) = (tri[1] - tri[0], tri[2] - tri[0]);
+    let n = e0.cross(e1);
+    // The plane must be well defined (the sine of the angle at `tri[0]` above 1e-6, so the
+    // exact test's own normal, computed otherwise, agrees with `n` to far better than the
+    // margin) and not nearly parallel to the row.
+    let len = n.length();
+    let restrict = len > 1e-6 * e0.length() * e1.length() && n.x.abs() > 1e-6 * len;
+    if !restrict {
+        return Some(range);
+    }
+    let r = half.x * n.x.abs() + half.y * n.y.abs() + half.z * n.z.abs();
+    let rest = n.dot(tri[0]) - n.y * (j as f64 + 0.5) - n.z * (k as f64 + 0.5);
+    let (a, b) = ((rest - r) / n.x, (rest + r) / n.x);
+    // Centre x = i + 0.5 lies in [min(a, b), max(a, b)]; one voxel of margin each way.
+    let lo = (a.min(b) - 1.5).floor().max(range.0 as f64);
+    let hi = (a.max(b) + 0.5).ceil().min(range.1 as f64);
+    (lo <= hi).then_some((lo as usize, hi as usize))
 }
 
 /// Dilates a 0/1 voxel set by one voxel in all 26 directions (a 3×3×3 box), done as three
@@ -145,6 +188,73 @@ mod tests {
             DVec3::new(-1.9, 3.0, 5.0),
         ];
         assert!(!triangle_box_overlap(DVec3::ZERO, DVec3::splat(0.5), tri));
+    }
+
+    /// Oracle: on random triangles (big, small, thin, axis-parallel, degenerate) the marks equal
+    /// those of testing every voxel of each triangle's bounding box.
+    #[test]
+    fn marks_equal_testing_every_voxel_of_the_box() {
+        use rand::{Rng, SeedableRng};
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(5);
+        let grid = Grid {
+            dims: [23, 19, 21],
+            origin: DVec3::new(-0.3, 0.1, 0.2),
+            voxel_size: 0.7,
+        };
+        let brute = |triangles: &[[DVec3; 3]]| {
+            let mut marked = vec![0u8; grid.len()];
+            let half = DVec3::splat(0.5 + 1e-9);
+            for (idx, m) in marked.iter_mut().enumerate() {
+                let c = grid.coords(idx);
+                let center = DVec3::new(c[0] as f64, c[1] as f64, c[2] as f64) + 0.5;
+                let hit = triangles
+                    .iter()
+                    .any(|tri| triangle_box_overlap(center, half, tri.map(|p| grid.to_grid(p))));
+                *m = u8::from(hit);
+            }
+            marked
+        };
+        let point = |rng: &mut rand_chacha::ChaCha8Rng| {
+            DVec3::new(
+                rng.random_range(0.0..15.0),
+                rng.random_range(0.0..13.0),
+                rng.random_range(0.0..14.0),
+            )
+        };
+        for case in 0..300 {
+            let triangles: Vec<[DVec3; 3]> = (0..4)
+                .map(|t| {
+                    let mut a = point(&mut rng);
+                    let mut b = point(&mut rng);
+                    let mut c = point(&mut rng);
+                    match (case + t) % 5 {
+                        0 => {
+                            // Small.
+                            b = a + (b - a) * 0.1;
+                            c = a + (c - a) * 0.1;
+                        }
+                        1 => {
+                            // In a plane x = const (parallel to the rows' normal axis).
+                            b.x = a.x;
+                            c.x = a.x;
+                        }
+                        2 => {
+                            // In a plane y = const, on voxel faces.
+                            let y = grid.origin.y + 0.7 * 6.0;
+                            (a.y, b.y, c.y) = (y, y, y);
+                        }
+                        3 => c = a + 0.5 * (b - a), // degenerate
+                        _ => {}
+                    }
+                    [a, b, c]
+                })
+                .collect();
+            assert_eq!(
+                mark_surface_voxels(&grid, &triangles),
+                brute(&triangles),
+                "case {case}"
+            );
+        }
     }
 
     #[test]
