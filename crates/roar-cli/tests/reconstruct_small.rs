@@ -147,3 +147,14 @@ fn same_input_config_and_seed_give_the_same_bits() {
     };
     assert_eq!(bits(&a.0), bits(&b.0));
 }
+
+#[test]
+fn the_final_mesh_is_smoothed_at_the_budget_without_intersections() {
+    let (positions, triangles, stats) = run_with(toy_config(300), Vec::new());
+    assert!(
+        stats.final_smoothing_moves > 0,
+        "the final sweeps moved nothing"
+    );
+    assert_eq!(triangles.len(), 300);
+    assert!(!self_intersecting_faces(&positions, &triangles).contains(&true));
+}

@@ -1,16 +1,26 @@
 //! Tangential smoothing ("improve quality", spec §3.9): one Jacobi sweep moving every smooth
 //! vertex toward the area-weighted barycentre of its incident face centroids, within its
-//! tangent plane. Sizing field s ≡ 1.
+//! tangent plane, then back onto the surface it left. Sizing field s ≡ 1.
 //!
 //! ```text
 //! q_v = Σ_f A_f c_f / Σ_f A_f
 //! v'  = v − λ_v (I − n_v n_vᵀ)(v − q_v),   λ_v = 1 if μ_v ≥ 0.98 else 0
+//! v'' = the point of v's incident faces (before the sweep) nearest to v'
 //! ```
+//!
+//! The last line is ours ([INF], as in isotropic remeshing, where tangential relaxation is
+//! followed by a projection back onto the surface): on a curved or creased neighbourhood
+//! (μ_v < 1) a move in the tangent plane leaves the surface, by up to about 15 % of the move at
+//! μ_v = 0.98. Without it each sweep undid part of the optimization: on
+//! cgal-non_manifold_face_graph at 1000 faces the render loss jumped by about 25 % after every
+//! sweep, climbed from 0.011 at iteration 20 to 0.064 at 200, and the output's Chamfer/diag was
+//! 2.71e-3 with the sweeps and 1.84e-3 with none.
 
 use crate::block::{Block, BlockContext, BlockStats};
 use crate::geometry::Geometry;
 use crate::optim::Optimizer;
 use crate::untangle::{LimiterOptions, limit_moves};
+use roar_mesh::spatial::closest_point_on_triangle;
 use roar_mesh::{DVec3, Mesh};
 
 /// Options of [`tangential_smoothing`] (spec §3.9).
@@ -61,8 +71,8 @@ pub fn tangential_smoothing(mesh: &mut Mesh, options: &SmoothingOptions) -> Bloc
         let p = mesh.position(v);
         let n = geometry.vertex_normals[v.index()];
         let d = p - sum / weight;
-        let tangential = d - n * n.dot(d);
-        moves.push((v, p - tangential));
+        let moved = p - (d - n * n.dot(d));
+        moves.push((v, nearest_on_faces_around(mesh, v, moved)));
     }
     let before = options
         .guard_intersections
@@ -90,6 +100,14 @@ pub fn tangential_smoothing(mesh: &mut Mesh, options: &SmoothingOptions) -> Bloc
     stats
 }
 
+/// The point of the faces around `v` (at the mesh's current positions) nearest to `p`.
+fn nearest_on_faces_around(mesh: &Mesh, v: roar_mesh::VertexId, p: DVec3) -> DVec3 {
+    mesh.faces_around(v)
+        .map(|f| closest_point_on_triangle(p, mesh.face_vertices(f).map(|u| mesh.position(u))).0)
+        .min_by(|a, b| a.distance_squared(p).total_cmp(&b.distance_squared(p)))
+        .unwrap_or(p)
+}
+
 /// [`Block`] wrapper of [`tangential_smoothing`].
 #[derive(Debug, Clone, Default)]
 pub struct TangentialSmoothing {
@@ -109,5 +127,76 @@ impl Block for TangentialSmoothing {
         _ctx: &BlockContext,
     ) -> BlockStats {
         tangential_smoothing(mesh, &self.options)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::qem::triangle_quality;
+    use roar_mesh::shapes::icosphere;
+
+    /// An icosphere whose vertices slid along the sphere by up to `amount` of the radius, so
+    /// its triangles are uneven but it stays on the unit sphere (to its chords).
+    fn uneven_sphere(amount: f64) -> Mesh {
+        let mut mesh = icosphere(3);
+        let mut state = 0x2545_F491_4F6C_DD1Du64;
+        let mut next = || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+        };
+        for p in mesh.positions_mut() {
+            let shifted = *p + amount * DVec3::new(next(), next(), next());
+            *p = shifted.normalize();
+        }
+        mesh
+    }
+
+    fn mean_quality(mesh: &Mesh) -> f64 {
+        let sum: f64 = mesh
+            .faces()
+            .map(|f| triangle_quality(mesh.face_vertices(f).map(|v| mesh.position(v))))
+            .sum();
+        sum / mesh.n_faces() as f64
+    }
+
+    #[test]
+    fn moved_vertices_stay_on_the_surface_they_left_and_triangles_improve() {
+        let before = uneven_sphere(0.08);
+        let mut after = before.clone();
+        let stats = tangential_smoothing(&mut after, &SmoothingOptions::default());
+        assert!(stats.accepted > before.n_vertices() / 2, "{stats:?}");
+        let mut moved = 0;
+        for v in before.vertices() {
+            let p = after.position(v);
+            if p == before.position(v) {
+                continue;
+            }
+            moved += 1;
+            // On one of the faces the vertex had before the sweep.
+            let off = before
+                .faces_around(v)
+                .map(|f| {
+                    let corners = before.face_vertices(f).map(|u| before.position(u));
+                    closest_point_on_triangle(p, corners).0.distance(p)
+                })
+                .fold(f64::INFINITY, f64::min);
+            assert!(off < 1e-12, "vertex {v:?} left its old faces by {off}");
+        }
+        assert!(moved > 0);
+        assert!(mean_quality(&after) < mean_quality(&before));
+        after.validate().unwrap();
+    }
+
+    #[test]
+    fn creases_and_folds_stay_put() {
+        // Every cube vertex is a corner (μ ≈ 0.58 < 0.98), so nothing moves.
+        let mut cube = roar_mesh::shapes::cube();
+        let before = cube.clone();
+        let stats = tangential_smoothing(&mut cube, &SmoothingOptions::default());
+        assert_eq!(stats.accepted, 0);
+        assert_eq!(cube, before);
     }
 }

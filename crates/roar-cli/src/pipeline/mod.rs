@@ -148,6 +148,9 @@ pub struct RunStats {
     pub untangle_rounds: usize,
     /// Collapses of the final QEM.
     pub final_collapses: usize,
+    /// Vertex moves of the tangential smoothing after the final QEM (`final_smoothing_sweeps`;
+    /// 0 also when the smoothed mesh was dropped because it would have intersected itself).
+    pub final_smoothing_moves: usize,
     /// Loss, terms and faces at every polish iteration (after the final QEM).
     pub polish_history: Vec<IterationRecord>,
     /// Whether the polished mesh was kept (false: it intersected itself, or no polish ran; true
@@ -340,6 +343,11 @@ impl Reconstruction {
         let decimated = final_decimation(&mut mesh, &config)?;
         stats.final_collapses = decimated.collapses;
         clock.lap("final_qem");
+
+        if config.iterations > 0 && config.final_smoothing_sweeps > 0 {
+            mesh = smooth_if_clean(mesh, &target.normalization, &config, &mut stats);
+            clock.lap("final_smoothing");
+        }
 
         // No Move Vertices step at all with `iterations = 0`: that run is the plain init + QEM.
         if config.iterations > 0 && config.polish_iterations > 0 {
@@ -696,6 +704,31 @@ fn fill_and_untangle(mesh: &mut Mesh, config: &ReconstructConfig, stats: &mut Ru
     record_untangle(stats, &untangled);
     stats.fill_splits += fill_to_budget(mesh, config.faces);
     untangled.unresolved_faces.len()
+}
+
+/// `config.final_smoothing_sweeps` sweeps of tangential smoothing with every move limited so
+/// that no face pair starts to intersect, kept only if the result is free of self-intersections
+/// in the input's coordinates, where it will be written (as for the polish and the sliver
+/// flips).
+fn smooth_if_clean(
+    mesh: Mesh,
+    normalization: &Normalization,
+    config: &ReconstructConfig,
+    stats: &mut RunStats,
+) -> Mesh {
+    let options = SmoothingOptions {
+        guard_intersections: true,
+        ..SmoothingOptions::default()
+    };
+    let mut smoothed = mesh.clone();
+    let moves: usize = (0..config.final_smoothing_sweeps)
+        .map(|_| roar_ops::smoothing::tangential_smoothing(&mut smoothed, &options).accepted)
+        .sum();
+    if moves == 0 || !clean_in_output_coordinates(&smoothed, normalization) {
+        return mesh;
+    }
+    stats.final_smoothing_moves = moves;
+    smoothed
 }
 
 /// The guaranteed QEM to exactly `config.faces` (best effort only if configured).
