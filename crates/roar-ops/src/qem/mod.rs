@@ -81,7 +81,7 @@ pub struct DecimateOptions {
     /// Measured with `quality_penalty_above` (decimating to 1000 faces, Chamfer/diag and median
     /// aspect ratio, old defaults → new): roar's 5000-face output of cgal-non_manifold_face_graph
     /// 3.22e-3, 1.58 → 2.74e-3, 1.24; the 5000-face init of manifoldplus-chair 4.31e-3, 1.92 →
-    /// 3.45e-3, 1.88; of luke-f-16 2.32e-3, 1.71 → 2.25e-3, 1.57. On clean organic meshes (spot,
+    /// 3.45e-3, 1.88; of luke-f-16 2.32e-3, 1.71 → 2.26e-3, 1.61. On clean organic meshes (spot,
     /// homer, rocker-arm) the planar terms cost 1–3 % Chamfer for a better median aspect ratio.
     pub planar_weight: f64,
     /// Run the self-intersection veto (default `true`). Switching it off makes decimation
