@@ -6,12 +6,12 @@
 //! the two inputs where the init + QEM is already about as close as roar gets:
 //!
 //! - the example, boxes and a zero-thickness sheet: since the QEM has planar quadrics, the
-//!   box-shaped init decimated to 1000 faces is at Chamfer/diag 1.88e-3 against roar's 1.86e-3
-//!   (200k samples; the one-sided distances agree within 2 %: what is left is the sheet's
-//!   thickness and the soup's interior faces, which no closed surface comes nearer to). It was
-//!   at 4.2e-3 before;
-//! - manifoldplus-chair, whose slat gaps the init's one-voxel closing fills (the genus roar keeps):
-//!   3.45e-3 against roar's 3.34e-3 (50k samples; it was 4.46e-3 before).
+//!   box-shaped init decimated to 1000 faces is about as close as roar gets (this test's
+//!   Chamfer/diag: 2.42e-3 against roar's 2.39e-3; it was 4.28e-3 before; the one-sided
+//!   distances agree within 2 %: what is left is the sheet's thickness and the soup's interior
+//!   faces, which no closed surface comes nearer to);
+//! - manifoldplus-chair, whose slat gaps the init's one-voxel closing fills (the genus roar
+//!   keeps): 2.83e-3 against roar's 2.69e-3 (it was 3.98e-3 before).
 
 use std::path::PathBuf;
 

@@ -139,17 +139,9 @@ mod tests {
     /// An icosphere whose vertices slid along the sphere by up to `amount` of the radius, so
     /// its triangles are uneven but it stays on the unit sphere (to its chords).
     fn uneven_sphere(amount: f64) -> Mesh {
-        let mut mesh = icosphere(3);
-        let mut state = 0x2545_F491_4F6C_DD1Du64;
-        let mut next = || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            (state >> 11) as f64 / (1u64 << 53) as f64 - 0.5
-        };
+        let mut mesh = roar_mesh::shapes::perturbed(&icosphere(3), amount, 11);
         for p in mesh.positions_mut() {
-            let shifted = *p + amount * DVec3::new(next(), next(), next());
-            *p = shifted.normalize();
+            *p = p.normalize();
         }
         mesh
     }

@@ -171,7 +171,8 @@ pub struct DecimateStats {
     pub quality_bound: Option<f64>,
     /// Heap passes run (each re-queues every live edge).
     pub passes: usize,
-    /// Largest quadric error of an applied collapse (squared distance × area units).
+    /// Largest cost of an applied collapse: its quadric error (squared distance × area units,
+    /// at least the tiny cost floor), times its quality penalty when it had one.
     pub max_cost: f64,
     /// The compaction done at the end (old → new ids); `None` for a no-op. Per-vertex caller
     /// data kept in step by the collapse callback must be permuted with it.
