@@ -118,6 +118,15 @@ pub struct ReconstructConfig {
     pub guard_intersections: bool,
     /// Separation margin of the untangle block, relative to the bounding-box diagonal.
     pub untangle_margin: f64,
+    /// Before the final QEM, move every vertex this far (relative to the bounding-box diagonal)
+    /// outward along its normal, as far as no intersection appears (0 = off; only when the
+    /// polish runs, which moves the vertices back onto the target). [INF] Not in the paper: the
+    /// loop pulls the two sides of a thin part or of an open surface onto one sheet, where the
+    /// QEM's self-intersection veto refuses nearly every collapse and the decimation eats the
+    /// part from its rim instead (libigl-camelhead, an open surface, decimated from its
+    /// 5000-face loop mesh to 1000: 5.9 % of the input farther than 1 % of the diagonal from
+    /// the output, 0.3 % with an offset of 5e-4).
+    pub final_qem_offset: f64,
     /// Move Vertices iterations at exactly N after the final QEM (0 = off), with the step
     /// limiter, a learning rate falling linearly to 0 and no blocks, so the face count and
     /// topology stay; the state with the lowest loss is kept. [INF] Not in the paper: the final
@@ -174,6 +183,7 @@ impl Default for ReconstructConfig {
             step_limiter: true,
             guard_intersections: false,
             untangle_margin: 1e-6,
+            final_qem_offset: 5e-4,
             polish_iterations: 20,
             sliver_quality: 10.0,
             best_effort: false,
@@ -220,6 +230,12 @@ impl ReconstructConfig {
             return Err(format!(
                 "sliver_quality = {} must be 0 (off) or at least 1",
                 self.sliver_quality
+            ));
+        }
+        if !(self.final_qem_offset >= 0.0 && self.final_qem_offset < 0.1) {
+            return Err(format!(
+                "final_qem_offset = {} must be at least 0 and below 0.1",
+                self.final_qem_offset
             ));
         }
         if self.init_resolution < 8 {

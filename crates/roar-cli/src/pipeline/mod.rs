@@ -148,6 +148,9 @@ pub struct RunStats {
     pub untangle_rounds: usize,
     /// Collapses of the final QEM.
     pub final_collapses: usize,
+    /// Vertices moved the whole `final_qem_offset` before the final QEM (the others were
+    /// shortened or kept where a full move would have made faces intersect).
+    pub offset_vertices: usize,
     /// Vertex moves of the tangential smoothing after the final QEM (`final_smoothing_sweeps`;
     /// 0 also when the smoothed mesh was dropped because it would have intersected itself).
     pub final_smoothing_moves: usize,
@@ -340,6 +343,11 @@ impl Reconstruction {
             stats.loss_last,
             mesh.n_faces(),
         );
+        let polishing = config.iterations > 0 && config.polish_iterations > 0;
+        if polishing && config.final_qem_offset > 0.0 {
+            stats.offset_vertices = offset_outward(&mut mesh, config.final_qem_offset);
+            clock.lap("offset");
+        }
         let decimated = final_decimation(&mut mesh, &config)?;
         stats.final_collapses = decimated.collapses;
         clock.lap("final_qem");
@@ -350,7 +358,7 @@ impl Reconstruction {
         }
 
         // No Move Vertices step at all with `iterations = 0`: that run is the plain init + QEM.
-        if config.iterations > 0 && config.polish_iterations > 0 {
+        if polishing {
             report("polish", config.iterations, stats.loss_last, mesh.n_faces());
             mesh = polish(
                 mesh,
@@ -731,6 +739,39 @@ fn smooth_if_clean(
     smoothed
 }
 
+/// Moves every vertex `relative × diagonal` outward along its normal, each move shortened or
+/// cancelled where it would make faces intersect; returns how many vertices moved the whole way.
+///
+/// Why: the optimization pulls the two sides of a thin part (and of an open surface, which the
+/// init wraps from both sides) onto the same sheet, closer than any chord the final QEM makes,
+/// so its self-intersection veto refuses nearly every collapse there and the decimation eats
+/// the part from its rim instead. Offset apart, the two sides decimate like any other surface;
+/// the polish then moves the vertices back onto the target.
+fn offset_outward(mesh: &mut Mesh, relative: f64) -> usize {
+    let (positions, triangles) = mesh.to_triangles();
+    let (lo, hi) = positions
+        .iter()
+        .fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), &p| {
+            (lo.min(p), hi.max(p))
+        });
+    let distance = relative * (hi - lo).length();
+    let normals = roar_loss::planar::vertex_normals(&positions, &triangles);
+    let mut moved: Vec<DVec3> = positions
+        .iter()
+        .zip(&normals)
+        .map(|(&p, &n)| p + distance * n)
+        .collect();
+    let limited = limit_moves(
+        &positions,
+        &mut moved,
+        &triangles,
+        &LimiterOptions::default(),
+    );
+    *mesh = Mesh::from_triangles(moved, &triangles)
+        .expect("moving vertices keeps the connectivity of a valid mesh");
+    positions.len() - limited.shortened - limited.cancelled
+}
+
 /// The guaranteed QEM to exactly `config.faces` (best effort only if configured).
 fn final_decimation(
     mesh: &mut Mesh,
@@ -832,5 +873,43 @@ mod tests {
         mesh.validate().unwrap();
         assert_eq!(mesh.n_faces(), faces);
         assert!(count_intersecting_faces(&mesh) == 0);
+    }
+
+    #[test]
+    fn the_offset_before_the_final_qem_moves_outward_without_crossing() {
+        // Two spheres 1e-3 apart: the offset (2e-3 of the 4.9 diagonal here, 1e-2 each) would
+        // push them into each other where they nearly touch, so those moves are shortened or
+        // cancelled; everywhere else every vertex moves the whole way along its normal.
+        let mut mesh = two_spheres(2.001);
+        let before = mesh.clone();
+        let moved = offset_outward(&mut mesh, 2e-3);
+        mesh.validate().unwrap();
+        assert_eq!(count_intersecting_faces(&mesh), 0);
+        assert!(moved < mesh.n_vertices() && moved > mesh.n_vertices() * 9 / 10);
+        let (lo, hi) = before
+            .vertices()
+            .map(|v| before.position(v))
+            .fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), p| {
+                (lo.min(p), hi.max(p))
+            });
+        let diagonal = (hi - lo).length();
+        let mut full = 0;
+        for v in mesh.vertices() {
+            let centre = if before.position(v).x < 1.0005 {
+                DVec3::ZERO
+            } else {
+                DVec3::X * 2.001
+            };
+            let grown =
+                (mesh.position(v) - centre).length() - (before.position(v) - centre).length();
+            assert!(
+                grown >= -1e-12 && grown <= 2e-3 * diagonal * (1.0 + 1e-9),
+                "{grown}"
+            );
+            if grown > 2e-3 * diagonal * 0.999 {
+                full += 1;
+            }
+        }
+        assert_eq!(full, moved);
     }
 }
