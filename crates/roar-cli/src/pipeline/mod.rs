@@ -137,6 +137,13 @@ pub struct RunStats {
     pub steps_shortened: usize,
     /// Edge splits used to fill up to N.
     pub fill_splits: usize,
+    /// Loss of the loop's last state (evaluated once more after the last iteration; 0 when
+    /// there was no checkpoint to compare it with).
+    pub loss_of_last_state: f64,
+    /// The iteration whose starting state the run finished from: `iterations` for the last
+    /// state, or the intersection-free checkpoint with the lowest loss when that was lower
+    /// (or when the last state could not be untangled).
+    pub finished_from_iteration: usize,
     /// Faces the untangle block could not clear on the loop's last mesh (0 when it could).
     pub unresolved_after_loop: usize,
     /// When that happened: the iteration of the intersection-free checkpoint the run finished
@@ -276,11 +283,15 @@ impl Reconstruction {
             },
         )?;
         let mut optimizer = new_optimizer(&mesh, &config)?;
-        // The init at the working budget is intersection-free (init and QEM promise it).
-        let mut checkpoint = (0, mesh.clone());
+        // The intersection-free state with the lowest loss seen at a checkpoint iteration (the
+        // init at the working budget is intersection-free: init and QEM promise it).
+        let mut best: Option<LoopState> = None;
         clock.lap("loop_setup");
 
         for iteration in 0..config.iterations {
+            let candidate = (config.checkpoint_interval > 0
+                && iteration % config.checkpoint_interval == 0)
+                .then(|| mesh.clone());
             let record = move_vertices(
                 &mut mesh,
                 &mut optimizer,
@@ -291,6 +302,11 @@ impl Reconstruction {
                 "loop",
             )?;
             let value = record.loss;
+            if let Some(candidate) = candidate {
+                // `value` is the loss of the state before this iteration's step.
+                consider_state(&mut best, candidate, iteration, value);
+                clock.lap("loop_checkpoint");
+            }
             if iteration == 0 {
                 stats.loss_first = value;
             }
@@ -312,24 +328,32 @@ impl Reconstruction {
                     clock.lap(&format!("loop_block_{}", scheduled.block.name()));
                 }
             }
-            let done = iteration + 1;
-            if config.checkpoint_interval > 0 && done % config.checkpoint_interval == 0 {
-                if count_intersecting_faces(&mesh) == 0 {
-                    checkpoint = (done, mesh.clone());
-                }
-                clock.lap("loop_checkpoint");
-            }
             report("optimize", iteration, value, mesh.n_faces());
         }
         stats.loop_faces = mesh.n_faces();
 
         report("finish", config.iterations, stats.loss_last, mesh.n_faces());
+        // Finish from the last state unless an earlier intersection-free one had a lower loss.
+        stats.finished_from_iteration = config.iterations;
+        if let Some(state) = best.take() {
+            let triangles = compact_triangles(&mut mesh, &mut optimizer);
+            let (last, _) = loss.value_and_grad(mesh.positions(), &triangles)?;
+            stats.loss_of_last_state = last;
+            clock.lap("loop_loss");
+            if state.loss < last {
+                stats.finished_from_iteration = state.iteration;
+                mesh = state.mesh;
+            } else {
+                best = Some(state);
+            }
+        }
         let mut unresolved = fill_and_untangle(&mut mesh, &config, &mut stats);
         clock.lap("untangle");
-        if unresolved > 0 && config.checkpoint_interval > 0 {
+        if let Some(state) = best.filter(|_| unresolved > 0) {
             stats.unresolved_after_loop = unresolved;
-            stats.finished_from_checkpoint = Some(checkpoint.0);
-            mesh = checkpoint.1;
+            stats.finished_from_checkpoint = Some(state.iteration);
+            stats.finished_from_iteration = state.iteration;
+            mesh = state.mesh;
             unresolved = fill_and_untangle(&mut mesh, &config, &mut stats);
             clock.lap("untangle");
         }
@@ -797,6 +821,25 @@ fn record_untangle(stats: &mut RunStats, untangled: &UntangleStats) {
     stats.untangle_rounds = untangled.rounds;
 }
 
+/// A state of the loop's mesh and its loss.
+struct LoopState {
+    iteration: usize,
+    loss: f64,
+    mesh: Mesh,
+}
+
+/// Keeps `mesh` (the state before `iteration`'s step, with loss `loss`) in `best` if its loss is
+/// the lowest so far and it is free of self-intersections.
+fn consider_state(best: &mut Option<LoopState>, mesh: Mesh, iteration: usize, loss: f64) {
+    if best.as_ref().is_none_or(|b| loss < b.loss) && count_intersecting_faces(&mesh) == 0 {
+        *best = Some(LoopState {
+            iteration,
+            loss,
+            mesh,
+        });
+    }
+}
+
 /// Accepted operations of a block, including nested blocks (the flips of Face Collapse).
 fn total_accepted(stats: &BlockStats) -> usize {
     stats.accepted + stats.sub.iter().map(total_accepted).sum::<usize>()
@@ -911,5 +954,20 @@ mod tests {
             }
         }
         assert_eq!(full, moved);
+    }
+
+    #[test]
+    fn the_kept_loop_state_has_the_lowest_loss_and_no_intersection() {
+        let (apart, crossing) = (two_spheres(3.0), two_spheres(1.9));
+        let mut best = None;
+        consider_state(&mut best, apart.clone(), 0, 2.0);
+        consider_state(&mut best, crossing, 10, 1.0); // lower, but intersecting: skipped
+        consider_state(&mut best, apart.clone(), 20, 3.0); // clean, but higher: skipped
+        assert_eq!(best.as_ref().map(|b| (b.iteration, b.loss)), Some((0, 2.0)));
+        consider_state(&mut best, apart, 30, 1.5);
+        assert_eq!(
+            best.as_ref().map(|b| (b.iteration, b.loss)),
+            Some((30, 1.5))
+        );
     }
 }
