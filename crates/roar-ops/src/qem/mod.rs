@@ -474,7 +474,18 @@ impl<'m, F: FnMut(&Collapse)> Decimator<'m, F> {
         on_collapse: F,
     ) -> Self {
         let mut quadrics = vec![Quadric::default(); mesh.vertex_capacity()];
-        for f in mesh.faces() {
+        // With a region, only the faces with a corner inside contribute: the quadric of every
+        // vertex inside is then complete (summed in the same face order, so bit for bit the
+        // same), and a vertex outside never takes part in a collapse, so its partial quadric
+        // only sets the heap cost of edges that are popped and skipped.
+        let contributes = |f: FaceId| {
+            region.is_none_or(|slab| {
+                mesh.face_vertices(f)
+                    .iter()
+                    .any(|&v| slab.contains(mesh.position(v)))
+            })
+        };
+        for f in mesh.faces().filter(|&f| contributes(f)) {
             let cross = mesh.face_cross(f);
             let len = cross.length();
             if !(len > 0.0 && len.is_finite()) {
@@ -670,7 +681,7 @@ impl<'m, F: FnMut(&Collapse)> Decimator<'m, F> {
                 mesh.position(v)
             }
         };
-        let (mut q_old, mut q_new) = (1.0f64, 1.0f64);
+        let mut q_new = 1.0f64;
         for corners in &self.fan {
             let old = corners.map(|v| mesh.position(v));
             let new = corners.map(moved);
@@ -688,11 +699,19 @@ impl<'m, F: FnMut(&Collapse)> Decimator<'m, F> {
             {
                 return Verdict::Refuse(Veto::NormalFlip);
             }
-            q_old = q_old.max(triangle_quality(old));
             q_new = q_new.max(triangle_quality(new));
         }
-        if q_new > bound && q_new > q_old {
-            return Verdict::Refuse(Veto::Quality);
+        // The replaced faces' worst quality matters only above the bound (rarely), so it is
+        // computed only then.
+        if q_new > bound {
+            let q_old = self
+                .fan
+                .iter()
+                .map(|c| triangle_quality(c.map(|v| mesh.position(v))))
+                .fold(1.0f64, f64::max);
+            if q_new > q_old {
+                return Verdict::Refuse(Veto::Quality);
+            }
         }
         let above = self.options.quality_penalty_above;
         if !penalized && above > 0.0 && q_new > above {
