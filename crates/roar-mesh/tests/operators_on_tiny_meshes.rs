@@ -237,3 +237,55 @@ fn geometry_helpers_follow_the_spec_defaults() {
     let h = HalfedgeId::from_index(0);
     assert_eq!(m.edge_length(h.edge()), 0.0);
 }
+
+/// Bipyramid over an `n`-gon: apexes `n` (top) and `n + 1` (bottom) of valence `n`, ring
+/// vertices of valence 4.
+fn bipyramid(n: usize) -> Mesh {
+    let mut p: Vec<DVec3> = (0..n)
+        .map(|k| {
+            let t = k as f64 * std::f64::consts::TAU / n as f64;
+            DVec3::new(t.cos(), t.sin(), 0.0)
+        })
+        .collect();
+    p.extend([DVec3::Z, DVec3::NEG_Z]);
+    let (top, bottom) = (n as u32, n as u32 + 1);
+    let t: Vec<[u32; 3]> = (0..n as u32)
+        .flat_map(|k| {
+            let next = (k + 1) % n as u32;
+            [[k, next, top], [next, k, bottom]]
+        })
+        .collect();
+    Mesh::from_triangles(p, &t).unwrap()
+}
+
+/// `can_collapse` counts the common neighbours right whether the rings fit its stack buffer
+/// (32 vertices) or not: on bipyramids with apexes of valence 6 and 40, every half-edge gets
+/// the answer of a brute-force count of common neighbours.
+#[test]
+fn collapse_check_is_the_same_for_small_and_large_rings() {
+    for n in [6, 40] {
+        let m = bipyramid(n);
+        for h in m.halfedges() {
+            let (a, b) = (m.tail(h), m.head(h));
+            let ring_b: Vec<VertexId> = m.neighbors(b).collect();
+            let shared = m.neighbors(a).filter(|x| ring_b.contains(x)).count();
+            let expected = if shared != 2 {
+                Err(TopoError::LinkCondition {
+                    shared_neighbors: shared,
+                })
+            } else {
+                Ok(())
+            };
+            match m.can_collapse(h) {
+                Err(TopoError::TetrahedronCollapse { .. }) => assert_eq!(expected, Ok(())),
+                got => assert_eq!(got, expected, "n = {n}, {a:?} -> {b:?}"),
+            }
+        }
+        // An equator edge (ring vertices of valence 4, apexes as wings) and an apex edge.
+        let equator = m.find_halfedge(v(0), v(1)).unwrap();
+        assert_eq!(m.can_collapse(equator), Ok(()));
+        let apex = m.find_halfedge(v(n), v(0)).unwrap();
+        assert_eq!(m.can_collapse(apex), Ok(()));
+        assert_eq!(m.can_collapse(apex.twin()), Ok(()));
+    }
+}

@@ -169,6 +169,117 @@ pub(crate) fn faces_intersect_filtered(positions: &[DVec3], ta: [u32; 3], tb: [u
     faces_intersect(positions, ta, tb)
 }
 
+/// A face prepared for many certified plane-side tests: its corner ids and positions, and the
+/// 2×2 minors of its plane, so that one test costs three products instead of a whole
+/// `orient3d` (the QEM intersection veto tests each new face against dozens of others).
+///
+/// [`PreparedFace::side`] evaluates `orient3d` with the face's first corner `c0` as the pivot,
+/// `det[q − c0; c1 − c0; c2 − c0]`, expanded along the row `q − c0`: the transpose of the
+/// matrix Shewchuk's `orient3dfast` expands along its last column. Each of the nine entries is
+/// one rounded difference of input coordinates and the evaluation has the same shape (three
+/// rounded products of an entry with a rounded 2×2 minor, summed left to right), so his error
+/// bound `o3derrboundA × permanent` certifies the sign exactly as in [`certain_orient3d`]; the
+/// minors and the minors' halves of the permanent depend on the face alone and are computed
+/// once.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct PreparedFace {
+    /// Corner ids (as given to [`faces_intersect`]).
+    pub ids: [u32; 3],
+    /// Corner positions.
+    pub corners: [DVec3; 3],
+    /// Rounded minors `(bd_y cd_z − bd_z cd_y, bd_z cd_x − bd_x cd_z, bd_x cd_y − bd_y cd_x)`
+    /// of `bd = c1 − c0`, `cd = c2 − c0`.
+    minors: DVec3,
+    /// The matching sums of absolute products (`|bd_y cd_z| + |bd_z cd_y|`, …).
+    weights: DVec3,
+}
+
+impl PreparedFace {
+    /// Prepares the face with corner ids `ids` at `corners`.
+    pub(crate) fn new(ids: [u32; 3], corners: [DVec3; 3]) -> PreparedFace {
+        let bd = corners[1] - corners[0];
+        let cd = corners[2] - corners[0];
+        let (yz, zy) = (bd.y * cd.z, bd.z * cd.y);
+        let (zx, xz) = (bd.z * cd.x, bd.x * cd.z);
+        let (xy, yx) = (bd.x * cd.y, bd.y * cd.x);
+        PreparedFace {
+            ids,
+            corners,
+            minors: DVec3::new(yz - zy, zx - xz, xy - yx),
+            weights: DVec3::new(
+                yz.abs() + zy.abs(),
+                zx.abs() + xz.abs(),
+                xy.abs() + yx.abs(),
+            ),
+        }
+    }
+
+    /// Bits `i` of the points `points[i]` certainly strictly above (first mask) and below
+    /// (second mask) the face's plane. Branch-free: the pair tests run millions of times with
+    /// unpredictable outcomes.
+    #[inline]
+    fn side_masks(&self, points: &[DVec3; 3]) -> (u8, u8) {
+        let (mut above, mut below) = (0u8, 0u8);
+        for (i, &q) in points.iter().enumerate() {
+            let ad = q - self.corners[0];
+            let (m, w) = (self.minors, self.weights);
+            let det = ad.x * m.x + ad.y * m.y + ad.z * m.z;
+            let permanent = ad.x.abs() * w.x + ad.y.abs() * w.y + ad.z.abs() * w.z;
+            let bound = O3D_ERR_BOUND * permanent;
+            above |= u8::from(det > bound) << i;
+            below |= u8::from(-det > bound) << i;
+        }
+        (above, below)
+    }
+
+    /// Whether `other`'s corners outside the mask `shared` (bit `i`: corner `i` is one of this
+    /// face's corners) are all certainly strictly on one side of this face's plane.
+    #[inline]
+    fn others_strictly_one_side(&self, other: &PreparedFace, shared: u8) -> bool {
+        let (above, below) = self.side_masks(&other.corners);
+        (above | shared) == 0b111 || (below | shared) == 0b111
+    }
+
+    /// Bit `i` set when corner `i` of this face is a corner of `other`.
+    #[inline]
+    fn shared_mask(&self, other: &PreparedFace) -> u8 {
+        let mut mask = 0u8;
+        for (i, &v) in self.ids.iter().enumerate() {
+            let found = (v == other.ids[0]) | (v == other.ids[1]) | (v == other.ids[2]);
+            mask |= u8::from(found) << i;
+        }
+        mask
+    }
+
+    /// Whether the three corner ids differ.
+    #[inline]
+    fn has_distinct_ids(&self) -> bool {
+        let [x, y, z] = self.ids;
+        (x != y) & (y != z) & (x != z)
+    }
+}
+
+/// True only if the two faces certainly do not intersect in the sense of [`faces_intersect`]:
+/// the corners of one face that are not shared with the other lie certainly strictly on one
+/// side of the other face's plane (tried both ways). `false` decides nothing: call
+/// [`faces_intersect_filtered`] then.
+///
+/// Why that proves it (faces with distinct corner ids, sharing `k ≤ 2` of them): the face
+/// whose unshared corners lie strictly on one side meets the other's plane only in its shared
+/// corners (`k = 0`: nowhere; `k = 1`: the shared corner; `k = 2`: the shared edge, its
+/// opposite corner being off the plane), and the other face lies in that plane, so the faces
+/// meet at most there: the fast negatives of [`faces_intersect_filtered`], with the shared
+/// edge case tried both ways.
+#[inline]
+pub(crate) fn certainly_apart(a: &PreparedFace, b: &PreparedFace) -> bool {
+    let (shared_a, shared_b) = (a.shared_mask(b), b.shared_mask(a));
+    let valid = a.has_distinct_ids()
+        & b.has_distinct_ids()
+        & (shared_a.count_ones() == shared_b.count_ones())
+        & (shared_b != 0b111);
+    valid && (a.others_strictly_one_side(b, shared_b) || b.others_strictly_one_side(a, shared_a))
+}
+
 /// True if the closed fan of triangles `(apex, rim[i][0], rim[i][1])` certainly has no two faces
 /// that intersect in the sense of [`faces_intersect`] (faces meet only in the apex and, for
 /// neighbours, along their shared edge), so the pairwise tests can be skipped.
@@ -384,5 +495,113 @@ mod tests {
             decided += (!exact) as usize;
         }
         assert!(decided > 300);
+    }
+
+    /// The exact sign of `orient3d(a, b, c, d)` (Shewchuk's adaptive predicate).
+    fn exact_orient3d(a: DVec3, b: DVec3, c: DVec3, d: DVec3) -> f64 {
+        let c3 = |p: DVec3| robust::Coord3D {
+            x: p.x,
+            y: p.y,
+            z: p.z,
+        };
+        robust::orient3d(c3(a), c3(b), c3(c), c3(d))
+    }
+
+    /// Points near a plane, far from the origin (so the differences round), with offsets from
+    /// 0 to well above the error bound: every side a prepared face certifies is the exact sign
+    /// of `orient3d(q, c1, c2, c0)`, and most clearly off-plane points are certified.
+    #[test]
+    fn prepared_sides_are_exact_signs() {
+        let mut rng = ChaCha8Rng::seed_from_u64(17);
+        let (mut certified, mut off_plane) = (0, 0);
+        for _ in 0..20_000 {
+            let origin = DVec3::new(1e3, -3e2, 7e2) * rng.random_range(0.0..1.0);
+            let u = DVec3::new(
+                rng.random_range(-1.0..1.0),
+                rng.random_range(-1.0..1.0),
+                rng.random_range(-1.0..1.0),
+            );
+            let v = DVec3::new(
+                rng.random_range(-1.0..1.0),
+                rng.random_range(-1.0..1.0),
+                rng.random_range(-1.0..1.0),
+            );
+            let n = u.cross(v);
+            let on_plane = |rng: &mut ChaCha8Rng, offset: f64| {
+                origin
+                    + u * rng.random_range(-2.0..2.0)
+                    + v * rng.random_range(-2.0..2.0)
+                    + n * offset
+            };
+            let corners = [0.0, 0.0, 0.0].map(|o| on_plane(&mut rng, o));
+            let face = PreparedFace::new([0, 1, 2], corners);
+            let offsets = [0.0, 1e-15, -1e-13, 1e-11, -1e-6];
+            let points = [0, 1, 2].map(|_| {
+                let offset = offsets[rng.random_range(0..5)];
+                on_plane(&mut rng, offset)
+            });
+            let (above, below) = face.side_masks(&points);
+            assert_eq!(above & below, 0);
+            for (i, &q) in points.iter().enumerate() {
+                let exact = exact_orient3d(q, corners[1], corners[2], corners[0]);
+                if above >> i & 1 == 1 {
+                    assert!(exact > 0.0, "{q:?} {corners:?}");
+                    certified += 1;
+                }
+                if below >> i & 1 == 1 {
+                    assert!(exact < 0.0, "{q:?} {corners:?}");
+                    certified += 1;
+                }
+                off_plane += usize::from(exact.abs() > 1e-9 * n.length());
+            }
+        }
+        assert!(certified > off_plane / 2, "{certified} of {off_plane}");
+    }
+
+    /// Random face pairs sharing 0–3 corner ids, on small integer coordinates (many exactly
+    /// coplanar or touching configurations) and on nearly coplanar real ones: whenever
+    /// `certainly_apart` answers yes, the exact test finds no intersection.
+    #[test]
+    fn certainly_apart_only_for_pairs_the_exact_test_finds_apart() {
+        let mut rng = ChaCha8Rng::seed_from_u64(23);
+        let (mut apart, mut exact_apart) = (0, 0);
+        for trial in 0..600 {
+            let positions: Vec<DVec3> = (0..8)
+                .map(|_| {
+                    let p = DVec3::new(
+                        rng.random_range(-2..=2) as f64,
+                        rng.random_range(-2..=2) as f64,
+                        rng.random_range(-2..=2) as f64,
+                    );
+                    if trial % 2 == 0 {
+                        p
+                    } else {
+                        // Nearly on the plane z = 0.3 x − 0.7 y.
+                        let z = 0.3 * p.x - 0.7 * p.y + rng.random_range(-1e-14..1e-14);
+                        DVec3::new(p.x + 0.1, p.y, z)
+                    }
+                })
+                .collect();
+            for _ in 0..50 {
+                let mut pick = || loop {
+                    let t: [u32; 3] = [0, 1, 2].map(|_| rng.random_range(0..8));
+                    if t[0] != t[1] && t[1] != t[2] && t[0] != t[2] {
+                        return t;
+                    }
+                };
+                let (ta, tb) = (pick(), pick());
+                if collinear(&positions, ta) || collinear(&positions, tb) {
+                    continue;
+                }
+                let prepare = |t: [u32; 3]| PreparedFace::new(t, t.map(|i| positions[i as usize]));
+                let exact = faces_intersect(&positions, ta, tb);
+                if certainly_apart(&prepare(ta), &prepare(tb)) {
+                    assert!(!exact, "{ta:?} {tb:?} {positions:?}");
+                    apart += 1;
+                }
+                exact_apart += usize::from(!exact);
+            }
+        }
+        assert!(apart > exact_apart / 3, "{apart} of {exact_apart}");
     }
 }

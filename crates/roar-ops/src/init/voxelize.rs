@@ -3,6 +3,7 @@
 
 use super::grid::Grid;
 use glam::DVec3;
+use rayon::prelude::*;
 
 /// Whether the triangle `(v0, v1, v2)` overlaps the closed axis-aligned box `center ± half`.
 ///
@@ -130,25 +131,36 @@ fn row_near_plane(
 }
 
 /// Dilates a 0/1 voxel set by one voxel in all 26 directions (a 3×3×3 box), done as three
-/// separable one-voxel passes along x, y and z.
+/// separable one-voxel passes along x, y and z. A voxel keeps its own value when non-zero and
+/// becomes 1 when a neighbour along the pass's axis is non-zero.
+///
+/// Each pass reads the previous one and writes every voxel from its own neighbours, so the
+/// z-slices are filled in parallel with the same result as one loop.
 pub(crate) fn dilate_box(grid: &Grid, set: &[u8]) -> Vec<u8> {
+    let [nx, ny, nz] = grid.dims;
+    let slice = nx * ny;
     let mut current = set.to_vec();
-    let strides = [1, grid.dims[0], grid.dims[0] * grid.dims[1]];
+    let mut next = vec![0u8; set.len()];
     for a in 0..3 {
-        let mut next = current.clone();
-        for idx in 0..grid.len() {
-            if current[idx] == 0 {
-                continue;
+        let stride = [1, nx, slice][a];
+        let cur = &current;
+        next.par_chunks_mut(slice).enumerate().for_each(|(k, out)| {
+            for j in 0..ny {
+                for i in 0..nx {
+                    let idx = i + nx * j + slice * k;
+                    let c = [i, j, k][a];
+                    let mut v = cur[idx];
+                    if v == 0 {
+                        let low = c > 0 && cur[idx - stride] != 0;
+                        let high = c + 1 < grid.dims[a] && cur[idx + stride] != 0;
+                        v = u8::from(low || high);
+                    }
+                    out[i + nx * j] = v;
+                }
             }
-            let c = grid.coords(idx);
-            if c[a] > 0 {
-                next[idx - strides[a]] = 1;
-            }
-            if c[a] + 1 < grid.dims[a] {
-                next[idx + strides[a]] = 1;
-            }
-        }
-        current = next;
+        });
+        debug_assert_eq!(nz * slice, set.len());
+        std::mem::swap(&mut current, &mut next);
     }
     current
 }
@@ -254,6 +266,42 @@ mod tests {
                 brute(&triangles),
                 "case {case}"
             );
+        }
+    }
+
+    #[test]
+    fn dilation_equals_the_brute_force_box_on_random_sets() {
+        let grid = Grid {
+            dims: [7, 5, 6],
+            origin: DVec3::ZERO,
+            voxel_size: 1.0,
+        };
+        let mut state = 12345u64;
+        let mut bit = || {
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            u8::from(state >> 60 == 0)
+        };
+        for _ in 0..20 {
+            let set: Vec<u8> = (0..grid.len()).map(|_| bit()).collect();
+            let d = dilate_box(&grid, &set);
+            for idx in 0..grid.len() {
+                let c = grid.coords(idx).map(|x| x as i64);
+                let mut any = false;
+                for dz in -1..=1i64 {
+                    for dy in -1..=1i64 {
+                        for dx in -1..=1i64 {
+                            let n = [c[0] + dx, c[1] + dy, c[2] + dz];
+                            if (0..3).all(|a| n[a] >= 0 && n[a] < grid.dims[a] as i64) {
+                                let [x, y, z] = n.map(|v| v as usize);
+                                any |= set[grid.index(x, y, z)] == 1;
+                            }
+                        }
+                    }
+                }
+                assert_eq!(d[idx], u8::from(any), "voxel {c:?}");
+            }
         }
     }
 

@@ -209,6 +209,24 @@ impl FaceGrid {
         }
     }
 
+    /// Reads the first entry of every bucket of the cells `lo..=hi`, without using it, so that
+    /// the cache misses of a query's buckets (most of its time on large meshes) overlap, where
+    /// the scan, whose branches depend on each entry, meets them one at a time.
+    #[inline]
+    fn touch(&self, lo: Cell, hi: Cell) {
+        let mut sink = 0u32;
+        for x in lo[0]..=hi[0] {
+            for y in lo[1]..=hi[1] {
+                for z in lo[2]..=hi[2] {
+                    if let Some(e) = self.buckets[self.bucket([x, y, z])].first() {
+                        sink ^= e.face;
+                    }
+                }
+            }
+        }
+        std::hint::black_box(sink);
+    }
+
     /// Calls `visit(face, its rounded box, its corners)` exactly once for every face whose
     /// rounded box overlaps `b` (and for no other face).
     ///
@@ -227,6 +245,7 @@ impl FaceGrid {
                 }
             }
         } else {
+            self.touch(lo, hi);
             for x in lo[0]..=hi[0] {
                 for y in lo[1]..=hi[1] {
                     for z in lo[2]..=hi[2] {

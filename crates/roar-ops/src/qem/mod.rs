@@ -39,7 +39,7 @@ mod heap;
 mod quadric;
 mod split;
 
-use crate::intersect::{faces_intersect_filtered, fan_is_embedded};
+use crate::intersect::{PreparedFace, certainly_apart, faces_intersect_filtered, fan_is_embedded};
 use glam::DVec3;
 use grid::{Box32, FaceGrid};
 use heap::EdgeHeap;
@@ -455,9 +455,9 @@ struct Decimator<'m, F: FnMut(&Collapse)> {
     /// Scratch: the corners (before the collapse) of the fan of the collapse being checked.
     fan: Vec<[VertexId; 3]>,
     /// Scratch: the fan's faces after the collapse (relabelled corners) and their boxes.
-    fan_scratch: Vec<([u32; 3], Box32)>,
-    /// Scratch: unmoved faces (corners, box) near the fan.
-    near_scratch: Vec<([u32; 3], Box32)>,
+    fan_scratch: Vec<(PreparedFace, Box32)>,
+    /// Scratch: unmoved faces near the fan, and their boxes.
+    near_scratch: Vec<(PreparedFace, Box32)>,
     /// Scratch: the rim edges of the fan after the collapse (see [`fan_is_embedded`]).
     rim_scratch: Vec<[DVec3; 2]>,
     collapses: usize,
@@ -504,7 +504,18 @@ impl<'m, F: FnMut(&Collapse)> Decimator<'m, F> {
         on_collapse: F,
     ) -> Self {
         let mut quadrics = vec![Quadric::default(); mesh.vertex_capacity()];
-        for f in mesh.faces() {
+        // With a region, only the faces with a corner inside contribute: the quadric of every
+        // vertex inside is then complete (summed in the same face order, so bit for bit the
+        // same), and a vertex outside never takes part in a collapse, so its partial quadric
+        // only sets the heap cost of edges that are popped and skipped.
+        let contributes = |f: FaceId| {
+            region.is_none_or(|slab| {
+                mesh.face_vertices(f)
+                    .iter()
+                    .any(|&v| slab.contains(mesh.position(v)))
+            })
+        };
+        for f in mesh.faces().filter(|&f| contributes(f)) {
             let cross = mesh.face_cross(f);
             let len = cross.length();
             if !(len > 0.0 && len.is_finite()) {
@@ -702,7 +713,7 @@ impl<'m, F: FnMut(&Collapse)> Decimator<'m, F> {
                 mesh.position(v)
             }
         };
-        let (mut q_old, mut q_new) = (1.0f64, 1.0f64);
+        let mut q_new = 1.0f64;
         for corners in &self.fan {
             let old = corners.map(|v| mesh.position(v));
             let new = corners.map(moved);
@@ -720,11 +731,19 @@ impl<'m, F: FnMut(&Collapse)> Decimator<'m, F> {
             {
                 return Verdict::Refuse(Veto::NormalFlip);
             }
-            q_old = q_old.max(triangle_quality(old));
             q_new = q_new.max(triangle_quality(new));
         }
-        if q_new > bound && q_new > q_old {
-            return Verdict::Refuse(Veto::Quality);
+        // The replaced faces' worst quality matters only above the bound (rarely), so it is
+        // computed only then.
+        if q_new > bound {
+            let q_old = self
+                .fan
+                .iter()
+                .map(|c| triangle_quality(c.map(|v| mesh.position(v))))
+                .fold(1.0f64, f64::max);
+            if q_new > q_old {
+                return Verdict::Refuse(Veto::Quality);
+            }
         }
         let above = self.options.quality_penalty_above;
         if !penalized && above > 0.0 && q_new > above {
@@ -751,29 +770,32 @@ impl<'m, F: FnMut(&Collapse)> Decimator<'m, F> {
         let mesh = &*self.mesh;
         let grid = self.grid.as_ref().expect("grid exists when checking");
         let positions = mesh.positions();
+        let corners_of = |t: [u32; 3]| t.map(|v| positions[v as usize]);
         let relabel = |c: [VertexId; 3]| c.map(|v| if v == a { b.raw() } else { v.raw() });
         // The faces of the star of `a` or `b` (the fan and the two removed faces) are exactly
         // the faces with `a` or `b` as a corner; the grid stores every face's current corners.
         let (a_raw, b_raw) = (a.raw(), b.raw());
         let in_star = |corners: [u32; 3]| corners.contains(&a_raw) || corners.contains(&b_raw);
-        // The new fan faces with their boxes, and the box of them all (rounded outward to
-        // `f32`, like the grid's: a box test only filters pairs for the exact test, so a
-        // slightly larger box never changes the answer).
+        // The new fan faces, prepared for the plane tests, with their boxes, and the box of
+        // them all (rounded outward to `f32`, like the grid's: a box test only filters pairs
+        // for the exact test, so a slightly larger box never changes the answer).
         let fan = &mut self.fan_scratch;
         fan.clear();
         let mut all: Option<Box32> = None;
         for &c in &self.fan {
-            let bx = Box32::around(&Aabb::from_triangle(c.map(|v| positions[v.index()])));
+            let ids = relabel(c);
+            let corners = corners_of(ids);
+            let bx = Box32::around(&Aabb::from_triangle(corners));
             all = Some(all.map_or(bx, |a| a.union(&bx)));
-            fan.push((relabel(c), bx));
+            fan.push((PreparedFace::new(ids, corners), bx));
         }
         // One grid query for the whole fan: the unmoved faces near it.
         let near = &mut self.near_scratch;
         near.clear();
         if let Some(all) = all {
-            grid.query(&all, |_, g_box, corners| {
-                if !in_star(corners) {
-                    near.push((corners, *g_box));
+            grid.query(&all, |_, g_box, ids| {
+                if !in_star(ids) {
+                    near.push((PreparedFace::new(ids, corners_of(ids)), *g_box));
                 }
             });
         }
@@ -786,16 +808,20 @@ impl<'m, F: FnMut(&Collapse)> Decimator<'m, F> {
                 .map(|c| [c[1], c[2]].map(|v| positions[v.index()])),
         );
         let test_fan_pairs = !fan_is_embedded(p, rim);
+        // A pair is tested exactly unless the prepared plane tests prove it apart.
+        let meet = |x: &PreparedFace, y: &PreparedFace| {
+            !certainly_apart(x, y) && faces_intersect_filtered(positions, x.ids, y.ids)
+        };
         let mut hit = false;
-        'fan: for (i, &(tri, bx)) in fan.iter().enumerate() {
-            for &(other, other_box) in fan[i + 1..].iter().filter(|_| test_fan_pairs) {
-                if other_box.overlaps(&bx) && faces_intersect_filtered(positions, tri, other) {
+        'fan: for (i, (tri, bx)) in fan.iter().enumerate() {
+            for (other, other_box) in fan[i + 1..].iter().filter(|_| test_fan_pairs) {
+                if other_box.overlaps(bx) && meet(tri, other) {
                     hit = true;
                     break 'fan;
                 }
             }
-            for &(other, g_box) in near.iter() {
-                if g_box.overlaps(&bx) && faces_intersect_filtered(positions, tri, other) {
+            for (other, g_box) in near.iter() {
+                if g_box.overlaps(bx) && meet(tri, other) {
                     hit = true;
                     break 'fan;
                 }
