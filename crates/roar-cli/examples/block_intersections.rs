@@ -85,8 +85,8 @@ fn main() {
         .run(&soup.positions, &soup.triangles, &mut |_| {})
         .expect("reconstruction");
     println!(
-        "unresolved after loop {}, finished from checkpoint {:?}",
-        out.stats.unresolved_after_loop, out.stats.finished_from_checkpoint
+        "untangle failures {:?}, finished from iteration {}",
+        out.stats.untangle_failures, out.stats.finished_from_iteration
     );
     for (name, (times, faces)) in tally.borrow().by_block.iter() {
         println!("{name}: raised the count {times} times, by {faces} faces in total");

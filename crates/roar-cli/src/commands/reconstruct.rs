@@ -135,11 +135,11 @@ pub fn run(args: &ReconstructArgs) -> anyhow::Result<()> {
         run: result.stats,
         config,
     };
-    if let Some(iteration) = report.run.finished_from_checkpoint {
+    for failure in &report.run.untangle_failures {
         eprintln!(
-            "note: {} faces of the last loop mesh could not be untangled; finished from the \
-             intersection-free mesh of iteration {iteration}",
-            report.run.unresolved_after_loop
+            "note: {} faces of the loop's state at iteration {} could not be untangled; tried the \
+             state with the next lowest loss",
+            failure.unresolved_faces, failure.iteration
         );
     }
     let json = serde_json::to_string_pretty(&report)?;

@@ -99,13 +99,13 @@ pub struct ReconstructConfig {
     /// move limited so that no intersection appears. [INF] Not in the paper: with the sweeps
     /// off in the loop, this is what keeps the output's triangles well shaped.
     pub final_smoothing_sweeps: usize,
-    /// Every this many iterations, keep a copy of the loop's mesh if it has no self-intersection
-    /// and the lowest loss so far (0 = off). The run finishes from that copy instead of the last
-    /// mesh when its loss is lower, or when the final untangle cannot clear the last mesh
-    /// (`run.finished_from_iteration` in the report). [INF] Not in the paper: the blocks make
-    /// the loss rise as well as fall, and after it levels off (by iteration 30–50 on the wild
-    /// meshes at 1000 faces) it drifts up (libigl-camelhead: 0.0486 at iteration 50, 0.0535 at
-    /// 199).
+    /// Every this many iterations, keep a copy of the loop's mesh and its loss (0 = only the
+    /// last state). The run finishes from the kept state with the lowest loss (the last one
+    /// included) that the untangle block can clear (`run.finished_from_iteration`,
+    /// `run.untangle_failures` in the report). [INF] Not in the paper: the blocks make the loss
+    /// rise as well as fall, and after it levels off (by iteration 30–50 on the wild meshes at
+    /// 1000 faces) it can drift up (libigl-camelhead: 0.0486 at iteration 50, 0.0535 at 199);
+    /// and the last state may be a tangle the untangle cannot clear.
     pub checkpoint_interval: usize,
     /// Shorten optimizer steps that would make faces intersect (`roar_ops::untangle::limit_steps`),
     /// so the loop itself keeps the mesh intersection-free where the blocks did.

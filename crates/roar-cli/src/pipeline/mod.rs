@@ -24,7 +24,7 @@ use roar_loss::{
     PointCloudOptions, RenderLoss, SharpEdgeOptions, Target, TargetOptions, WeightedSum,
     build_target, point_cloud, sharp_edge_samples,
 };
-use roar_mesh::spatial::{Normalization, count_intersecting_faces, self_intersecting_faces};
+use roar_mesh::spatial::{Normalization, self_intersecting_faces};
 use roar_mesh::{EdgeId, Mesh};
 use roar_ops::block::{Block, BlockContext, BlockStats};
 use roar_ops::collapse_block::{FaceCollapse, FaceCollapseOptions};
@@ -137,18 +137,14 @@ pub struct RunStats {
     pub steps_shortened: usize,
     /// Edge splits used to fill up to N.
     pub fill_splits: usize,
-    /// Loss of the loop's last state (evaluated once more after the last iteration; 0 when
-    /// there was no checkpoint to compare it with).
+    /// Loss of the loop's last state (evaluated once more after the last iteration).
     pub loss_of_last_state: f64,
-    /// The iteration whose starting state the run finished from: `iterations` for the last
-    /// state, or the intersection-free checkpoint with the lowest loss when that was lower
-    /// (or when the last state could not be untangled).
+    /// The iteration whose starting state the run finished from (`iterations` for the state
+    /// after the last one): the lowest-loss state of the checkpoints and the last one that the
+    /// untangle block could clear (`checkpoint_interval`).
     pub finished_from_iteration: usize,
-    /// Faces the untangle block could not clear on the loop's last mesh (0 when it could).
-    pub unresolved_after_loop: usize,
-    /// When that happened: the iteration of the intersection-free checkpoint the run finished
-    /// from instead (0 = the init at the working budget).
-    pub finished_from_checkpoint: Option<usize>,
+    /// States with a lower loss that the untangle block could not clear, in the order tried.
+    pub untangle_failures: Vec<UntangleFailure>,
     /// Untangle statistics.
     pub untangle_initial_pairs: usize,
     /// Rounds the untangle block needed.
@@ -283,9 +279,8 @@ impl Reconstruction {
             },
         )?;
         let mut optimizer = new_optimizer(&mesh, &config)?;
-        // The intersection-free state with the lowest loss seen at a checkpoint iteration (the
-        // init at the working budget is intersection-free: init and QEM promise it).
-        let mut best: Option<LoopState> = None;
+        // The loop's state and its loss at every checkpoint iteration, to finish from.
+        let mut states: Vec<LoopState> = Vec::new();
         clock.lap("loop_setup");
 
         for iteration in 0..config.iterations {
@@ -302,9 +297,13 @@ impl Reconstruction {
                 "loop",
             )?;
             let value = record.loss;
-            if let Some(candidate) = candidate {
+            if let Some(mesh) = candidate {
                 // `value` is the loss of the state before this iteration's step.
-                consider_state(&mut best, candidate, iteration, value);
+                states.push(LoopState {
+                    iteration,
+                    loss: value,
+                    mesh,
+                });
                 clock.lap("loop_checkpoint");
             }
             if iteration == 0 {
@@ -333,33 +332,17 @@ impl Reconstruction {
         stats.loop_faces = mesh.n_faces();
 
         report("finish", config.iterations, stats.loss_last, mesh.n_faces());
-        // Finish from the last state unless an earlier intersection-free one had a lower loss.
-        stats.finished_from_iteration = config.iterations;
-        if let Some(state) = best.take() {
-            let triangles = compact_triangles(&mut mesh, &mut optimizer);
-            let (last, _) = loss.value_and_grad(mesh.positions(), &triangles)?;
-            stats.loss_of_last_state = last;
-            clock.lap("loop_loss");
-            if state.loss < last {
-                stats.finished_from_iteration = state.iteration;
-                mesh = state.mesh;
-            } else {
-                best = Some(state);
-            }
-        }
-        let mut unresolved = fill_and_untangle(&mut mesh, &config, &mut stats);
+        let triangles = compact_triangles(&mut mesh, &mut optimizer);
+        let (last, _) = loss.value_and_grad(mesh.positions(), &triangles)?;
+        stats.loss_of_last_state = last;
+        states.push(LoopState {
+            iteration: config.iterations,
+            loss: last,
+            mesh,
+        });
+        clock.lap("loop_loss");
+        let mut mesh = finish_from_best_state(states, &config, &mut stats)?;
         clock.lap("untangle");
-        if let Some(state) = best.filter(|_| unresolved > 0) {
-            stats.unresolved_after_loop = unresolved;
-            stats.finished_from_checkpoint = Some(state.iteration);
-            stats.finished_from_iteration = state.iteration;
-            mesh = state.mesh;
-            unresolved = fill_and_untangle(&mut mesh, &config, &mut stats);
-            clock.lap("untangle");
-        }
-        if unresolved > 0 {
-            return Err(PipelineError::Intersections(unresolved));
-        }
 
         report(
             "decimate",
@@ -821,6 +804,15 @@ fn record_untangle(stats: &mut RunStats, untangled: &UntangleStats) {
     stats.untangle_rounds = untangled.rounds;
 }
 
+/// A loop state the untangle block could not clear.
+#[derive(Debug, Clone, Default, Serialize)]
+pub struct UntangleFailure {
+    /// The iteration whose starting state it was (`iterations` for the last state).
+    pub iteration: usize,
+    /// Faces still intersecting.
+    pub unresolved_faces: usize,
+}
+
 /// A state of the loop's mesh and its loss.
 struct LoopState {
     iteration: usize,
@@ -828,16 +820,34 @@ struct LoopState {
     mesh: Mesh,
 }
 
-/// Keeps `mesh` (the state before `iteration`'s step, with loss `loss`) in `best` if its loss is
-/// the lowest so far and it is free of self-intersections.
-fn consider_state(best: &mut Option<LoopState>, mesh: Mesh, iteration: usize, loss: f64) {
-    if best.as_ref().is_none_or(|b| loss < b.loss) && count_intersecting_faces(&mesh) == 0 {
-        *best = Some(LoopState {
-            iteration,
-            loss,
-            mesh,
+/// Fills and untangles the loop's states in order of increasing loss (the later one first
+/// among equals) and returns the first one the untangle block clears, recording the others in
+/// `stats.untangle_failures`. Fails with the last state's unresolved face count when none
+/// clears.
+fn finish_from_best_state(
+    mut states: Vec<LoopState>,
+    config: &ReconstructConfig,
+    stats: &mut RunStats,
+) -> Result<Mesh, PipelineError> {
+    states.sort_by(|a, b| {
+        a.loss
+            .total_cmp(&b.loss)
+            .then(b.iteration.cmp(&a.iteration))
+    });
+    let mut unresolved = 0;
+    for state in states {
+        let mut mesh = state.mesh;
+        unresolved = fill_and_untangle(&mut mesh, config, stats);
+        if unresolved == 0 {
+            stats.finished_from_iteration = state.iteration;
+            return Ok(mesh);
+        }
+        stats.untangle_failures.push(UntangleFailure {
+            iteration: state.iteration,
+            unresolved_faces: unresolved,
         });
     }
+    Err(PipelineError::Intersections(unresolved))
 }
 
 /// Accepted operations of a block, including nested blocks (the flips of Face Collapse).
@@ -872,6 +882,7 @@ impl StageClock {
 mod tests {
     use super::*;
     use roar_mesh::shapes::icosphere;
+    use roar_mesh::spatial::count_intersecting_faces;
 
     /// Two unit icospheres whose centres are `distance` apart, as one mesh of two pieces.
     fn two_spheres(distance: f64) -> Mesh {
@@ -957,17 +968,37 @@ mod tests {
     }
 
     #[test]
-    fn the_kept_loop_state_has_the_lowest_loss_and_no_intersection() {
-        let (apart, crossing) = (two_spheres(3.0), two_spheres(1.9));
-        let mut best = None;
-        consider_state(&mut best, apart.clone(), 0, 2.0);
-        consider_state(&mut best, crossing, 10, 1.0); // lower, but intersecting: skipped
-        consider_state(&mut best, apart.clone(), 20, 3.0); // clean, but higher: skipped
-        assert_eq!(best.as_ref().map(|b| (b.iteration, b.loss)), Some((0, 2.0)));
-        consider_state(&mut best, apart, 30, 1.5);
-        assert_eq!(
-            best.as_ref().map(|b| (b.iteration, b.loss)),
-            Some((30, 1.5))
-        );
+    fn the_run_finishes_from_the_lowest_loss_state_the_untangle_clears() {
+        // A sphere scrambled into a tangle the untangle cannot clear, with the lowest loss.
+        let mut tangle = icosphere(2);
+        for (k, p) in tangle.positions_mut().iter_mut().enumerate() {
+            let t = k as f64;
+            *p = DVec3::new((1.7 * t).sin(), (2.3 * t).cos(), (3.1 * t).sin());
+        }
+        let state = |iteration, loss, mesh: &Mesh| LoopState {
+            iteration,
+            loss,
+            mesh: mesh.clone(),
+        };
+        let apart = two_spheres(3.0);
+        let states = vec![
+            state(0, 3.0, &apart),
+            state(10, 1.0, &tangle),
+            state(20, 2.0, &apart),
+            state(30, 2.0, &apart),
+        ];
+        let config = ReconstructConfig {
+            faces: apart.n_faces(),
+            ..ReconstructConfig::default()
+        };
+        let mut stats = RunStats::default();
+        let mesh = finish_from_best_state(states, &config, &mut stats).unwrap();
+        assert_eq!(stats.untangle_failures.len(), 1);
+        assert_eq!(stats.untangle_failures[0].iteration, 10);
+        assert!(stats.untangle_failures[0].unresolved_faces > 0);
+        // Of the two clean states with the next lowest loss, the later one.
+        assert_eq!(stats.finished_from_iteration, 30);
+        assert_eq!(mesh.n_faces(), apart.n_faces());
+        assert_eq!(count_intersecting_faces(&mesh), 0);
     }
 }
