@@ -7,11 +7,14 @@
 //!
 //! - the example, boxes and a zero-thickness sheet: since the QEM has planar quadrics, the
 //!   box-shaped init decimated to 1000 faces is about as close as roar gets (this test's
-//!   Chamfer/diag: 2.42e-3 against roar's 2.39e-3; it was 4.28e-3 before; the one-sided
+//!   Chamfer/diag: 2.42e-3 against roar's 2.38e-3; it was 4.28e-3 before; the one-sided
 //!   distances agree within 2 %: what is left is the sheet's thickness and the soup's interior
 //!   faces, which no closed surface comes nearer to);
 //! - manifoldplus-chair, whose slat gaps the init's one-voxel closing fills (the genus roar
-//!   keeps): 2.83e-3 against roar's 2.69e-3 (it was 3.98e-3 before).
+//!   keeps): 2.91e-3 against roar's 2.68e-3 (−8.1 %; it was 3.98e-3 before).
+//!
+//! Measured with the sixth session's code (in release, at load 5): trimesh-rabbit 3.31e-3 →
+//! 2.39e-3 (−27.8 %), luke-f-16 1.89e-3 → 1.51e-3 (−19.9 %); 1124 s for the four inputs.
 
 use std::path::PathBuf;
 
