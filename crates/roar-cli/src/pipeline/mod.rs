@@ -137,7 +137,8 @@ pub struct RunStats {
     pub steps_shortened: usize,
     /// Edge splits used to fill up to N.
     pub fill_splits: usize,
-    /// Loss of the loop's last state (evaluated once more after the last iteration).
+    /// Loss of the loop's last state (evaluated once more after the last iteration; NaN, null
+    /// in the report, when no checkpoint was kept to compare it with).
     pub loss_of_last_state: f64,
     /// The iteration whose starting state the run finished from (`iterations` for the state
     /// after the last one): the lowest-loss state of the checkpoints and the last one that the
@@ -332,8 +333,13 @@ impl Reconstruction {
         stats.loop_faces = mesh.n_faces();
 
         report("finish", config.iterations, stats.loss_last, mesh.n_faces());
-        let triangles = compact_triangles(&mut mesh, &mut optimizer);
-        let (last, _) = loss.value_and_grad(mesh.positions(), &triangles)?;
+        // The last state's loss decides only when there are other states to compare with.
+        let last = if states.is_empty() {
+            f64::NAN
+        } else {
+            let triangles = compact_triangles(&mut mesh, &mut optimizer);
+            loss.value_and_grad(mesh.positions(), &triangles)?.0
+        };
         stats.loss_of_last_state = last;
         states.push(LoopState {
             iteration: config.iterations,
