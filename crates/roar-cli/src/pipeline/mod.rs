@@ -761,6 +761,8 @@ fn smooth_if_clean(
 /// the part from its rim instead. Offset apart, the two sides decimate like any other surface;
 /// the polish then moves the vertices back onto the target.
 fn offset_outward(mesh: &mut Mesh, relative: f64) -> usize {
+    // Compact, the mesh's vertex ids are the indices of `to_triangles`.
+    mesh.compact();
     let (positions, triangles) = mesh.to_triangles();
     let (lo, hi) = positions
         .iter()
@@ -780,8 +782,7 @@ fn offset_outward(mesh: &mut Mesh, relative: f64) -> usize {
         &triangles,
         &LimiterOptions::default(),
     );
-    *mesh = Mesh::from_triangles(moved, &triangles)
-        .expect("moving vertices keeps the connectivity of a valid mesh");
+    mesh.positions_mut().copy_from_slice(&moved);
     positions.len() - limited.shortened - limited.cancelled
 }
 
