@@ -24,7 +24,7 @@ use roar_loss::{
     PointCloudOptions, RenderLoss, SharpEdgeOptions, Target, TargetOptions, WeightedSum,
     build_target, point_cloud, sharp_edge_samples,
 };
-use roar_mesh::spatial::{Normalization, self_intersecting_faces};
+use roar_mesh::spatial::{Aabb, Normalization, self_intersecting_faces};
 use roar_mesh::{EdgeId, Mesh};
 use roar_ops::block::{Block, BlockContext, BlockStats};
 use roar_ops::collapse_block::{FaceCollapse, FaceCollapseOptions};
@@ -764,12 +764,8 @@ fn offset_outward(mesh: &mut Mesh, relative: f64) -> usize {
     // Compact, the mesh's vertex ids are the indices of `to_triangles`.
     mesh.compact();
     let (positions, triangles) = mesh.to_triangles();
-    let (lo, hi) = positions
-        .iter()
-        .fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), &p| {
-            (lo.min(p), hi.max(p))
-        });
-    let distance = relative * (hi - lo).length();
+    let diagonal = Aabb::from_points(positions.iter().copied()).map_or(0.0, |b| b.diagonal());
+    let distance = relative * diagonal;
     let normals = roar_loss::planar::vertex_normals(&positions, &triangles);
     let mut moved: Vec<DVec3> = positions
         .iter()
@@ -947,13 +943,9 @@ mod tests {
         mesh.validate().unwrap();
         assert_eq!(count_intersecting_faces(&mesh), 0);
         assert!(moved < mesh.n_vertices() && moved > mesh.n_vertices() * 9 / 10);
-        let (lo, hi) = before
-            .vertices()
-            .map(|v| before.position(v))
-            .fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), p| {
-                (lo.min(p), hi.max(p))
-            });
-        let diagonal = (hi - lo).length();
+        let diagonal = Aabb::from_points(before.positions().iter().copied())
+            .unwrap()
+            .diagonal();
         let mut full = 0;
         for v in mesh.vertices() {
             let centre = if before.position(v).x < 1.0005 {

@@ -542,13 +542,8 @@ impl<'m, F: FnMut(&Collapse)> Decimator<'m, F> {
                 }
             }
         }
-        let (lo, hi) = mesh
-            .vertices()
-            .map(|v| mesh.position(v))
-            .fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), p| {
-                (lo.min(p), hi.max(p))
-            });
-        let diagonal = (hi - lo).length();
+        let diagonal = Aabb::from_points(mesh.vertices().map(|v| mesh.position(v)))
+            .map_or(0.0, |b| b.diagonal());
         // Area × squared distance, far below any real error (1e-8 of the diagonal off a plane
         // over the whole bounding box), yet positive so that penalties order flat collapses.
         let cost_floor = if diagonal.is_finite() {
