@@ -1,6 +1,6 @@
 //! The step limiter: shortens optimizer steps that would create a self-intersection.
 
-use crate::intersect::faces_intersect_filtered as faces_cross;
+use crate::intersect::{PreparedFace, certainly_apart, faces_intersect_filtered as faces_cross};
 use glam::DVec3;
 use roar_mesh::spatial::{Aabb, TriangleBvh};
 
@@ -101,7 +101,8 @@ pub fn limit_steps(
                 continue;
             }
             let tf = *tf;
-            let b = Aabb::from_triangle(tf.map(|i| current[i as usize]));
+            let pf = PreparedFace::new(tf, tf.map(|i| current[i as usize]));
+            let b = Aabb::from_triangle(pf.corners);
             candidates.clear();
             tree.faces_in_aabb(&b, |g| candidates.push(g));
             for &g in &candidates {
@@ -110,7 +111,8 @@ pub fn limit_steps(
                     continue;
                 }
                 stats.pair_tests += 1;
-                if faces_cross(&current, tf, tg) {
+                let pg = PreparedFace::new(tg, tg.map(|i| current[i as usize]));
+                if !certainly_apart(&pf, &pg) && faces_cross(&current, tf, tg) {
                     offending.extend_from_slice(&tf);
                     offending.extend_from_slice(&tg);
                 }
