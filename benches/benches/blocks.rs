@@ -2,7 +2,10 @@
 //! Face Split under and at budget against the analytic sphere projector (O(1) per sample),
 //! tangential smoothing. Goal: < 20 ms per block call. The Face Split goal excludes the
 //! projection it is given: `sphere_projection_of_split_samples` times that projection alone
-//! (same samples), to subtract from the `face_split_*` figures.
+//! (same samples), to subtract from the `face_split_*` figures. `step_limiter_*`: the step
+//! limiter on two concentric ~5k-face icospheres close together (an open surface pulled onto
+//! one sheet has such pairs), once with small steps (one pass) and once with steps three times
+//! the gap (many intersecting pairs, several passes).
 
 use criterion::{BatchSize, Criterion, criterion_main};
 use rand::SeedableRng;
@@ -15,6 +18,7 @@ use roar_ops::geometry::Geometry;
 use roar_ops::optim::{Optimizer, OptimizerOptions};
 use roar_ops::smoothing::{SmoothingOptions, tangential_smoothing};
 use roar_ops::split_block::{FaceSplitOptions, SplitThreshold, face_split};
+use roar_ops::untangle::{LimiterOptions, limit_steps};
 use std::hint::black_box;
 
 /// Latitude–longitude unit sphere: `2·lon·(lat − 1)` faces (50 × 100 → 9800).
@@ -139,6 +143,36 @@ fn blocks(c: &mut Criterion) {
     });
     group.finish();
 
+    let mut group = c.benchmark_group("step_limiter_10k_faces");
+    group.sample_size(20);
+    let (shells, shell_triangles) = two_shells(4, 0.005);
+    for (label, scale) in [("small_steps", 0.001), ("steps_across_the_gap", 0.015)] {
+        let proposed = jitter(&shells, scale);
+        group.bench_function(label, |b| {
+            b.iter_batched(
+                || proposed.clone(),
+                |mut p| {
+                    black_box(limit_steps(
+                        &shells,
+                        &mut p,
+                        &shell_triangles,
+                        &LimiterOptions::default(),
+                    ))
+                },
+                BatchSize::LargeInput,
+            )
+        });
+        let mut p = proposed.clone();
+        let stats = limit_steps(
+            &shells,
+            &mut p,
+            &shell_triangles,
+            &LimiterOptions::default(),
+        );
+        eprintln!("step limiter {label}: {stats:?}");
+    }
+    group.finish();
+
     // One-off stats so the figures can be read against the work done.
     let (mut m, mut o) = (folded.clone(), optimizer(&folded));
     eprintln!(
@@ -150,6 +184,30 @@ fn blocks(c: &mut Criterion) {
         "face_split under budget: {:?}",
         face_split(&mut m, &mut o, &sphere, f + 2000, &split_options)
     );
+}
+
+/// Two concentric icospheres `gap` apart: positions and triangles (#F = 2 × 20·4^level).
+fn two_shells(level: u32, gap: f64) -> (Vec<DVec3>, Vec<[u32; 3]>) {
+    let (inner, t) = roar_mesh::shapes::icosphere(level).to_triangles();
+    let offset = inner.len() as u32;
+    let mut positions = inner.clone();
+    positions.extend(inner.iter().map(|p| *p * (1.0 + gap)));
+    let mut triangles = t.clone();
+    triangles.extend(t.iter().map(|f| f.map(|i| i + offset)));
+    (positions, triangles)
+}
+
+/// `positions` each moved by a pseudo-random step of up to `scale` per coordinate (seed 0).
+fn jitter(positions: &[DVec3], scale: f64) -> Vec<DVec3> {
+    use rand::Rng;
+    let mut rng = ChaCha8Rng::seed_from_u64(0);
+    positions
+        .iter()
+        .map(|p| {
+            let r = DVec3::new(rng.random(), rng.random(), rng.random());
+            *p + scale * (2.0 * r - DVec3::ONE)
+        })
+        .collect()
 }
 
 mod group {

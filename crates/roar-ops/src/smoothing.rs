@@ -19,7 +19,7 @@
 use crate::block::{Block, BlockContext, BlockStats};
 use crate::geometry::Geometry;
 use crate::optim::Optimizer;
-use crate::untangle::{LimiterOptions, limit_moves};
+use crate::untangle::{LimiterOptions, limit_steps};
 use roar_mesh::spatial::closest_point_on_triangle;
 use roar_mesh::{DVec3, Mesh};
 
@@ -29,7 +29,7 @@ pub struct SmoothingOptions {
     /// Vertices with normal magnitude μ_v below this stay put (creases, spikes, folds).
     /// Default 0.98 ([SUP], §3.9).
     pub min_normal_magnitude: f64,
-    /// Shorten or cancel moves that would make faces intersect ([`limit_moves`], counted in
+    /// Shorten or cancel moves that would make faces intersect ([`limit_steps`], counted in
     /// `counters["shortened"]`, `counters["cancelled"]`). Default off (the paper's block); the
     /// pipeline's `guard_intersections` key switches it on. [INF]
     pub guard_intersections: bool,
@@ -88,7 +88,7 @@ pub fn tangential_smoothing(mesh: &mut Mesh, options: &SmoothingOptions) -> Bloc
             .faces()
             .map(|f| mesh.face_vertices(f).map(|v| v.raw()))
             .collect();
-        let limited = limit_moves(
+        let limited = limit_steps(
             &before,
             mesh.positions_mut(),
             &triangles,

@@ -35,7 +35,7 @@ use roar_ops::qem::{DecimateError, DecimateOptions, DecimateStats, decimate};
 use roar_ops::slivers::{SliverOptions, flip_slivers};
 use roar_ops::smoothing::{SmoothingOptions, TangentialSmoothing};
 use roar_ops::split_block::{FaceSplit, FaceSplitOptions, SplitThreshold};
-use roar_ops::untangle::{LimiterOptions, UntangleOptions, UntangleStats, limit_moves, untangle};
+use roar_ops::untangle::{LimiterOptions, UntangleOptions, UntangleStats, limit_steps, untangle};
 use serde::Serialize;
 
 pub use config::{InitKind, ReconstructConfig};
@@ -584,7 +584,7 @@ fn move_vertices(
         .map_err(|e| PipelineError::Internal(e.to_string()))?;
     clock.lap(&format!("{stage}_step"));
     if let Some(before) = before {
-        let limited = limit_moves(
+        let limited = limit_steps(
             &before,
             mesh.positions_mut(),
             &triangles,
@@ -772,7 +772,7 @@ fn offset_outward(mesh: &mut Mesh, relative: f64) -> usize {
         .zip(&normals)
         .map(|(&p, &n)| p + distance * n)
         .collect();
-    let limited = limit_moves(
+    let limited = limit_steps(
         &positions,
         &mut moved,
         &triangles,

@@ -27,7 +27,7 @@ mod pairs;
 mod resolve;
 mod separate;
 
-pub use limiter::{LimiterOptions, LimiterStats, limit_moves, limit_steps};
+pub use limiter::{LimiterOptions, LimiterStats, limit_steps};
 
 use collapse::{Buffers, quality, try_collapse_face};
 use roar_mesh::spatial::{Aabb, TriangleBvh};
