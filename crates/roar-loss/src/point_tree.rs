@@ -169,9 +169,14 @@ fn build(entries: &mut [([f32; 3], u32)], start: usize, nodes: &mut Vec<Node>) {
         2
     };
     let mid = count / 2;
-    entries.select_nth_unstable_by(mid, |a, b| {
-        a.0[axis].total_cmp(&b.0[axis]).then(a.1.cmp(&b.1))
-    });
+    // Ties on the split coordinate may fall on either side: answers are a function of the
+    // point set alone, and the selection is deterministic, so the tree is too. One comparator
+    // per axis keeps the coordinate index a constant in the selection's inner loop.
+    match axis {
+        0 => entries.select_nth_unstable_by(mid, |a, b| a.0[0].total_cmp(&b.0[0])),
+        1 => entries.select_nth_unstable_by(mid, |a, b| a.0[1].total_cmp(&b.0[1])),
+        _ => entries.select_nth_unstable_by(mid, |a, b| a.0[2].total_cmp(&b.0[2])),
+    };
     node.axis = axis as u8;
     node.split = entries[mid].0[axis];
     nodes.push(node);
@@ -204,6 +209,7 @@ fn build(entries: &mut [([f32; 3], u32)], start: usize, nodes: &mut Vec<Node>) {
 /// Bit `i` set iff `d2[i] ≤ bound` (never for NaN).
 #[inline]
 fn within(d2: &[f32; LEAF_SIZE], bound: f32) -> u32 {
+    const _: () = assert!(LEAF_SIZE <= 32);
     let mut mask = 0;
     for (i, &d) in d2.iter().enumerate() {
         mask |= ((d <= bound) as u32) << i;
@@ -498,6 +504,22 @@ mod tests {
             let nearest = tree.nearest_one(q, hint);
             assert_eq!(nearest, Some(brute(&points, q, 1)[0].1));
             hint = nearest;
+        }
+    }
+
+    #[test]
+    fn within_sets_one_bit_per_slot_at_or_below_the_bound() {
+        let mut rng = ChaCha8Rng::seed_from_u64(4);
+        for _ in 0..200 {
+            let d2: [f32; LEAF_SIZE] = std::array::from_fn(|_| match rng.random_range(0..4) {
+                0 => f32::NAN,
+                1 => 0.5,
+                _ => rng.random(),
+            });
+            let plain = (0..LEAF_SIZE)
+                .filter(|&i| d2[i] <= 0.5)
+                .fold(0u32, |m, i| m | 1 << i);
+            assert_eq!(within(&d2, 0.5), plain);
         }
     }
 
