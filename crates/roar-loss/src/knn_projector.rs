@@ -164,8 +164,7 @@ impl KnnPlanarProjector {
         found.extend(
             scratch
                 .items()
-                .iter()
-                .map(|&(_, j)| (j, self.points[j as usize].distance_squared(p))),
+                .map(|(_, j)| (j, self.points[j as usize].distance_squared(p))),
         );
         found.sort_unstable_by(|a, b| a.1.total_cmp(&b.1).then(a.0.cmp(&b.0)));
     }

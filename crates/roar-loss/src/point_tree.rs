@@ -25,9 +25,10 @@ const PRUNE_SLACK: f32 = 1.0 + 1e-5;
 /// One node, in preorder (the left child of an inner node is the next node).
 #[derive(Debug, Clone, Copy)]
 struct Node {
-    /// First point of the node in tree order.
+    /// First point of the node in tree order; for a leaf once the tree is built, its first slot
+    /// in the padded leaf arrays (a multiple of [`LEAF_SIZE`]).
     start: u32,
-    /// One past the last point.
+    /// One past the last point (slot).
     end: u32,
     /// Split axis (0, 1, 2), or [`LEAF`].
     axis: u8,
@@ -42,12 +43,15 @@ struct Node {
 #[derive(Debug, Clone, Default)]
 pub(crate) struct PointTree {
     nodes: Vec<Node>,
-    /// Point coordinates in tree order, one array per axis (each leaf's points are contiguous,
-    /// so a leaf's distances compute in SIMD lanes).
+    /// Point coordinates of the leaves, one array per axis, each leaf in a block of
+    /// [`LEAF_SIZE`] slots padded with NaN (whose distances compare false with any bound), so a
+    /// leaf's distances compute in fixed-width SIMD lanes.
     xs: Vec<f32>,
     ys: Vec<f32>,
     zs: Vec<f32>,
-    /// Input index of each point in tree order.
+    /// Input index of each slot of the leaf blocks (`u32::MAX` for padding).
+    leaf_ids: Vec<u32>,
+    /// Input index of each point in tree order (no padding).
     ids: Vec<u32>,
     /// Point coordinates in input order (to turn a previous answer into a search bound).
     coords_by_id: Vec<[f32; 3]>,
@@ -56,60 +60,78 @@ pub(crate) struct PointTree {
 /// The best neighbours of one query, sorted by (squared distance, index); a reusable buffer so
 /// queries do not allocate. The previous answer also seeds the next query's search bound
 /// (consecutive queries are usually close), which changes the work, never the answer.
+///
+/// Each neighbour is kept as one `u64` key, the f32 squared distance's bits above the index:
+/// distances are never negative, so their bits order like the numbers and the keys order like
+/// the pairs (ties broken by the smaller index) with a single comparison.
 #[derive(Debug, Clone, Default)]
 pub(crate) struct Neighbours {
-    items: Vec<(f32, u32)>,
+    keys: Vec<u64>,
     k: usize,
     /// Squared distance within which at least `k` points are known to lie (∞ if unknown).
     limit: f32,
+    /// A key enters iff it is below this: the limit's (any index) until `k` are found, then the
+    /// current `k`-th key.
+    enter_below: u64,
+    /// The squared distance of `enter_below`, for pruning (never below a distance that can
+    /// still enter).
+    bound: f32,
+}
+
+/// The sort key of `(d2, id)` (see [`Neighbours`]).
+#[inline]
+fn key(d2: f32, id: u32) -> u64 {
+    ((d2.to_bits() as u64) << 32) | id as u64
 }
 
 impl Neighbours {
     /// The neighbours found by the last query: `(f32 squared distance, index)` pairs, nearest
     /// first.
-    pub(crate) fn items(&self) -> &[(f32, u32)] {
-        &self.items
+    pub(crate) fn items(&self) -> impl ExactSizeIterator<Item = (f32, u32)> + '_ {
+        self.keys
+            .iter()
+            .map(|&key| (f32::from_bits((key >> 32) as u32), key as u32))
     }
 
     /// Clears the buffer for a query of `k` neighbours known to lie within squared distance
-    /// `limit`.
+    /// `limit` (not NaN).
     fn reset(&mut self, k: usize, limit: f32) {
-        self.items.clear();
+        self.keys.clear();
         self.k = k;
         self.limit = limit;
+        self.enter_below = key(limit, u32::MAX).saturating_add(1);
+        self.bound = limit;
     }
 
     /// The squared distance a point must not exceed to enter: the limit until `k` are found,
     /// then the current `k`-th distance (never above the limit).
     #[inline]
     fn bound(&self) -> f32 {
-        if self.items.len() < self.k {
-            self.limit
-        } else {
-            self.items[self.k - 1].0
-        }
+        self.bound
     }
 
     /// Inserts `(d2, id)` if it is among the `k` best so far (ties broken by smaller index).
     #[inline]
     fn offer(&mut self, d2: f32, id: u32) {
-        let before = |item: &(f32, u32)| item.0 < d2 || (item.0 == d2 && item.1 < id);
-        let len = self.items.len();
-        if len == self.k {
-            if before(&self.items[len - 1]) {
-                return;
-            }
-        } else {
-            self.items.push((d2, id));
+        let new = key(d2, id);
+        if new >= self.enter_below {
+            return;
         }
-        // Shift the worse items up by one (dropping the last when full) and insert.
-        let items = &mut self.items[..];
-        let mut pos = items.len() - 1;
-        while pos > 0 && !before(&items[pos - 1]) {
-            items[pos] = items[pos - 1];
+        if self.keys.len() < self.k {
+            self.keys.push(new);
+        }
+        // Shift the worse keys up by one (dropping the last when full) and insert.
+        let keys = &mut self.keys[..];
+        let mut pos = keys.len() - 1;
+        while pos > 0 && keys[pos - 1] > new {
+            keys[pos] = keys[pos - 1];
             pos -= 1;
         }
-        items[pos] = (d2, id);
+        keys[pos] = new;
+        if keys.len() == self.k {
+            self.enter_below = keys[self.k - 1];
+            self.bound = f32::from_bits((self.enter_below >> 32) as u32);
+        }
     }
 }
 
@@ -147,9 +169,14 @@ fn build(entries: &mut [([f32; 3], u32)], start: usize, nodes: &mut Vec<Node>) {
         2
     };
     let mid = count / 2;
-    entries.select_nth_unstable_by(mid, |a, b| {
-        a.0[axis].total_cmp(&b.0[axis]).then(a.1.cmp(&b.1))
-    });
+    // Ties on the split coordinate may fall on either side: answers are a function of the
+    // point set alone, and the selection is deterministic, so the tree is too. One comparator
+    // per axis keeps the coordinate index a constant in the selection's inner loop.
+    match axis {
+        0 => entries.select_nth_unstable_by(mid, |a, b| a.0[0].total_cmp(&b.0[0])),
+        1 => entries.select_nth_unstable_by(mid, |a, b| a.0[1].total_cmp(&b.0[1])),
+        _ => entries.select_nth_unstable_by(mid, |a, b| a.0[2].total_cmp(&b.0[2])),
+    };
     node.axis = axis as u8;
     node.split = entries[mid].0[axis];
     nodes.push(node);
@@ -179,6 +206,17 @@ fn build(entries: &mut [([f32; 3], u32)], start: usize, nodes: &mut Vec<Node>) {
     }
 }
 
+/// Bit `i` set iff `d2[i] ≤ bound` (never for NaN).
+#[inline]
+fn within(d2: &[f32; LEAF_SIZE], bound: f32) -> u32 {
+    const _: () = assert!(LEAF_SIZE <= 32);
+    let mut mask = 0;
+    for (i, &d) in d2.iter().enumerate() {
+        mask |= ((d <= bound) as u32) << i;
+    }
+    mask
+}
+
 #[inline]
 fn to_f32(p: DVec3) -> [f32; 3] {
     [p.x as f32, p.y as f32, p.z as f32]
@@ -206,9 +244,25 @@ impl PointTree {
         if !entries.is_empty() {
             build(&mut entries, 0, &mut tree.nodes);
         }
-        tree.xs = entries.iter().map(|e| e.0[0]).collect();
-        tree.ys = entries.iter().map(|e| e.0[1]).collect();
-        tree.zs = entries.iter().map(|e| e.0[2]).collect();
+        // Leaves into padded blocks, in tree order.
+        let leaves = tree.nodes.iter().filter(|n| n.axis == LEAF).count();
+        tree.xs = vec![f32::NAN; leaves * LEAF_SIZE];
+        tree.ys = vec![f32::NAN; leaves * LEAF_SIZE];
+        tree.zs = vec![f32::NAN; leaves * LEAF_SIZE];
+        tree.leaf_ids = vec![u32::MAX; leaves * LEAF_SIZE];
+        let mut slot = 0;
+        for node in tree.nodes.iter_mut().filter(|n| n.axis == LEAF) {
+            let (start, end) = (node.start as usize, node.end as usize);
+            for (i, (c, id)) in entries[start..end].iter().enumerate() {
+                tree.xs[slot + i] = c[0];
+                tree.ys[slot + i] = c[1];
+                tree.zs[slot + i] = c[2];
+                tree.leaf_ids[slot + i] = *id;
+            }
+            node.start = slot as u32;
+            node.end = (slot + end - start) as u32;
+            slot += LEAF_SIZE;
+        }
         tree.coords_by_id = points.iter().map(|&p| to_f32(p)).collect();
         tree.ids = entries.iter().map(|e| e.1).collect();
         tree
@@ -226,11 +280,11 @@ impl PointTree {
     pub(crate) fn nearest_n(&self, query: DVec3, k: usize, found: &mut Neighbours) {
         let q = to_f32(query);
         let mut limit = f32::INFINITY;
-        if k > 0 && found.items.len() == k {
+        if k > 0 && found.keys.len() == k {
             // The previous k neighbours all lie within `limit` of the new query.
             limit = 0.0;
-            for &(_, id) in &found.items {
-                match self.coords_by_id.get(id as usize) {
+            for &key in &found.keys {
+                match self.coords_by_id.get(key as u32 as usize) {
                     Some(c) => limit = limit.max(distance2(c, &q)),
                     None => limit = f32::INFINITY,
                 }
@@ -240,7 +294,8 @@ impl PointTree {
         if k == 0 || self.nodes.is_empty() {
             return;
         }
-        self.search(0, &q, [0.0; 3], 0.0, found);
+        let start = self.start_node(&q, limit);
+        self.search(start, &q, [0.0; 3], 0.0, found);
     }
 
     /// The nearest point of `query` (ties: smaller index); `None` for an empty tree. `hint`, a
@@ -255,20 +310,45 @@ impl PointTree {
             .map_or(f32::INFINITY, |c| distance2(c, &q));
         // Starts at (limit, u32::MAX): the hint itself always qualifies, so `best` is filled.
         let mut best = (limit, u32::MAX);
-        self.search_one(0, &q, [0.0; 3], 0.0, &mut best);
+        let start = self.start_node(&q, limit);
+        self.search_one(start, &q, [0.0; 3], 0.0, &mut best);
         Some(best.1)
+    }
+
+    /// The deepest node whose subtree holds every point within squared distance `limit` of `q`
+    /// (`q` lies in its cell): the descent follows `q` while the split plane is farther than
+    /// the limit. A point beyond the plane has an f32 squared distance of at least the plane's
+    /// (rounding is monotone), so skipping the other side is exact, ties included; the search
+    /// then starts there with zero cell offsets.
+    fn start_node(&self, q: &[f32; 3], limit: f32) -> u32 {
+        let mut node = 0;
+        loop {
+            let nd = self.nodes[node as usize];
+            if nd.axis == LEAF {
+                return node;
+            }
+            let diff = q[nd.axis as usize] - nd.split;
+            // A NaN (non-finite query or limit) stops the descent too.
+            let beyond = diff * diff > limit;
+            if !beyond {
+                return node;
+            }
+            node = if diff < 0.0 { node + 1 } else { nd.right };
+        }
     }
 
     /// [`PointTree::search`] for a single neighbour `best = (d2, id)`, without the buffer.
     fn search_one(&self, node: u32, q: &[f32; 3], off: [f32; 3], rd: f32, best: &mut (f32, u32)) {
         let nd = self.nodes[node as usize];
         if nd.axis == LEAF {
-            let (start, end) = (nd.start as usize, nd.end as usize);
-            let mut d2 = [0.0; LEAF_SIZE];
-            let d2 = self.leaf_distances(nd, q, &mut d2);
-            for (&d2, &id) in d2.iter().zip(&self.ids[start..end]) {
-                if d2 < best.0 || (d2 == best.0 && id < best.1) {
-                    *best = (d2, id);
+            let d2 = self.leaf_distances(nd, q);
+            let mut mask = within(&d2, best.0);
+            while mask != 0 {
+                let i = mask.trailing_zeros() as usize;
+                mask &= mask - 1;
+                let id = self.leaf_ids[nd.start as usize + i];
+                if d2[i] < best.0 || (d2[i] == best.0 && id < best.1) {
+                    *best = (d2[i], id);
                 }
             }
             return;
@@ -289,22 +369,17 @@ impl PointTree {
         }
     }
 
-    /// Squared distances from `q` to the points of leaf `leaf`, written to the front of `out`.
+    /// Squared distances from `q` to the slots of leaf `leaf` (NaN for padding).
     #[inline]
-    fn leaf_distances<'a>(
-        &self,
-        leaf: Node,
-        q: &[f32; 3],
-        out: &'a mut [f32; LEAF_SIZE],
-    ) -> &'a [f32] {
-        let (start, end) = (leaf.start as usize, leaf.end as usize);
-        let out = &mut out[..end - start];
+    fn leaf_distances(&self, leaf: Node, q: &[f32; 3]) -> [f32; LEAF_SIZE] {
+        let block = leaf.start as usize..leaf.start as usize + LEAF_SIZE;
         let (xs, ys, zs) = (
-            &self.xs[start..end],
-            &self.ys[start..end],
-            &self.zs[start..end],
+            &self.xs[block.clone()],
+            &self.ys[block.clone()],
+            &self.zs[block],
         );
-        for i in 0..out.len() {
+        let mut out = [0.0; LEAF_SIZE];
+        for i in 0..LEAF_SIZE {
             let (dx, dy, dz) = (xs[i] - q[0], ys[i] - q[1], zs[i] - q[2]);
             out[i] = dx * dx + dy * dy + dz * dz;
         }
@@ -315,13 +390,12 @@ impl PointTree {
     fn search(&self, node: u32, q: &[f32; 3], off: [f32; 3], rd: f32, found: &mut Neighbours) {
         let nd = self.nodes[node as usize];
         if nd.axis == LEAF {
-            let (start, end) = (nd.start as usize, nd.end as usize);
-            let mut d2 = [0.0; LEAF_SIZE];
-            let d2 = self.leaf_distances(nd, q, &mut d2);
-            for (&d2, &id) in d2.iter().zip(&self.ids[start..end]) {
-                if d2 <= found.bound() {
-                    found.offer(d2, id);
-                }
+            let d2 = self.leaf_distances(nd, q);
+            let mut mask = within(&d2, found.bound());
+            while mask != 0 {
+                let i = mask.trailing_zeros() as usize;
+                mask &= mask - 1;
+                found.offer(d2[i], self.leaf_ids[nd.start as usize + i]);
             }
             return;
         }
@@ -384,8 +458,8 @@ mod tests {
                 for k in [1, 10, 40] {
                     tree.nearest_n(q, k, &mut found);
                     assert_eq!(
-                        found.items(),
-                        brute(&points, q, k).as_slice(),
+                        found.items().collect::<Vec<_>>(),
+                        brute(&points, q, k),
                         "n {n} k {k}"
                     );
                 }
@@ -402,14 +476,62 @@ mod tests {
     }
 
     #[test]
+    fn coherent_queries_match_brute_force() {
+        // Queries on and next to the points, in the tree's spatial order: the previous answer
+        // gives tight bounds, so the searches start deep in the tree (`start_node`).
+        let mut rng = ChaCha8Rng::seed_from_u64(8);
+        let n = 3000;
+        let mut points: Vec<DVec3> = (0..n)
+            .map(|_| DVec3::new(rng.random(), rng.random(), rng.random()) * 2.0 - DVec3::ONE)
+            .collect();
+        for i in 0..n / 5 {
+            points[i] = points[n - 1 - i];
+        }
+        for p in points.iter_mut().take(n / 3) {
+            p.z = 0.25;
+        }
+        let tree = PointTree::new(&points);
+        let mut found = Neighbours::default();
+        let mut hint = None;
+        for (step, &id) in tree.spatial_order().iter().enumerate().step_by(3) {
+            let jitter = if step % 2 == 0 { 0.0 } else { 1e-3 };
+            let q =
+                points[id as usize] + DVec3::new(rng.random(), rng.random(), rng.random()) * jitter;
+            for k in [1, 10] {
+                tree.nearest_n(q, k, &mut found);
+                assert_eq!(found.items().collect::<Vec<_>>(), brute(&points, q, k));
+            }
+            let nearest = tree.nearest_one(q, hint);
+            assert_eq!(nearest, Some(brute(&points, q, 1)[0].1));
+            hint = nearest;
+        }
+    }
+
+    #[test]
+    fn within_sets_one_bit_per_slot_at_or_below_the_bound() {
+        let mut rng = ChaCha8Rng::seed_from_u64(4);
+        for _ in 0..200 {
+            let d2: [f32; LEAF_SIZE] = std::array::from_fn(|_| match rng.random_range(0..4) {
+                0 => f32::NAN,
+                1 => 0.5,
+                _ => rng.random(),
+            });
+            let plain = (0..LEAF_SIZE)
+                .filter(|&i| d2[i] <= 0.5)
+                .fold(0u32, |m, i| m | 1 << i);
+            assert_eq!(within(&d2, 0.5), plain);
+        }
+    }
+
+    #[test]
     fn empty_tree_and_zero_k_give_nothing() {
         let tree = PointTree::new(&[]);
         assert_eq!(tree.nearest_one(DVec3::ZERO, Some(3)), None);
         let tree = PointTree::new(&[DVec3::X]);
         let mut found = Neighbours::default();
         tree.nearest_n(DVec3::ZERO, 0, &mut found);
-        assert!(found.items().is_empty());
+        assert_eq!(found.items().len(), 0);
         tree.nearest_n(DVec3::ZERO, 3, &mut found);
-        assert_eq!(found.items(), &[(1.0, 0)]);
+        assert_eq!(found.items().collect::<Vec<_>>(), [(1.0, 0)]);
     }
 }

@@ -169,25 +169,53 @@ pub fn antialias_items(
     // skipped here without the depth comparison.
     let smooth = |a: u32, b: u32| ctx.smooth_across(a, b) && ctx.smooth_across(b, a);
     for (y, row) in ids.chunks_exact(w).enumerate() {
-        for (x, (&a, &b)) in row.iter().zip(&row[1..]).enumerate() {
-            if a != b
-                && !smooth(a, b)
+        for_each_differing(row, &row[1..], |x| {
+            if !smooth(row[x], row[x + 1])
                 && let Some(item) = ctx.pair(y * w + x, y * w + x + 1, true)
             {
                 items.push(item);
             }
-        }
+        });
     }
-    for (p, (&a, &b)) in ids.iter().zip(&ids[w.min(ids.len())..]).enumerate() {
-        if a != b
-            && !smooth(a, b)
+    for_each_differing(ids, &ids[w.min(ids.len())..], |p| {
+        if !smooth(ids[p], ids[p + w])
             && let Some(item) = ctx.pair(p, p + w, false)
         {
             items.push(item);
         }
-    }
+    });
     items.sort_by_key(|it| it.target);
     items
+}
+
+/// Calls `visit(i)` for every `i < min(a.len(), b.len())` with `a[i] != b[i]`, in increasing
+/// order. Runs of equal ids (the background, the inside of a face) are skipped eight at a time.
+#[inline]
+fn for_each_differing(a: &[u32], b: &[u32], mut visit: impl FnMut(usize)) {
+    const BLOCK: usize = 8;
+    let n = a.len().min(b.len());
+    let (a, b) = (&a[..n], &b[..n]);
+    let mut start = 0;
+    for (ab, bb) in a.chunks_exact(BLOCK).zip(b.chunks_exact(BLOCK)) {
+        // One OR of XORs tells whether the whole block is equal (SIMD-friendly).
+        let mut any = 0u32;
+        for i in 0..BLOCK {
+            any |= ab[i] ^ bb[i];
+        }
+        if any != 0 {
+            for i in 0..BLOCK {
+                if ab[i] != bb[i] {
+                    visit(start + i);
+                }
+            }
+        }
+        start += BLOCK;
+    }
+    for i in start..n {
+        if a[i] != b[i] {
+            visit(i);
+        }
+    }
 }
 
 struct PairContext<'a> {
@@ -300,6 +328,19 @@ impl PairContext<'_> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn differing_positions_match_a_plain_scan() {
+        // Runs of equal ids with changes at scattered places, lengths around the block size.
+        for n in [0usize, 1, 7, 8, 9, 17, 64, 101] {
+            let a: Vec<u32> = (0..n as u32).map(|i| (i / 5) % 3).collect();
+            let b: Vec<u32> = (0..n as u32 + 2).map(|i| (i / 7) % 3).collect();
+            let mut found = Vec::new();
+            for_each_differing(&a, &b, |i| found.push(i));
+            let plain: Vec<usize> = (0..n).filter(|&i| a[i] != b[i]).collect();
+            assert_eq!(found, plain, "n {n}");
+        }
+    }
 
     #[test]
     fn crossing_finite_difference() {
