@@ -68,8 +68,6 @@ pub(crate) struct PointTree {
 pub(crate) struct Neighbours {
     keys: Vec<u64>,
     k: usize,
-    /// Squared distance within which at least `k` points are known to lie (∞ if unknown).
-    limit: f32,
     /// A key enters iff it is below this: the limit's (any index) until `k` are found, then the
     /// current `k`-th key.
     enter_below: u64,
@@ -98,7 +96,6 @@ impl Neighbours {
     fn reset(&mut self, k: usize, limit: f32) {
         self.keys.clear();
         self.k = k;
-        self.limit = limit;
         self.enter_below = key(limit, u32::MAX).saturating_add(1);
         self.bound = limit;
     }
