@@ -21,12 +21,10 @@ use std::time::Instant;
 
 use glam::DVec3;
 use roar_cli::pipeline::{
-    PipelineError, Prepared, ReconstructConfig, Reconstruction, default_loss,
+    PipelineError, Prepared, ReconstructConfig, Reconstruction, default_loss, planar_options,
+    target_options,
 };
-use roar_loss::{
-    KnnOptions, Loss, LossError, PlanarLoss, PlanarOptions, PointCloud, RenderLoss, TargetOptions,
-    build_target,
-};
+use roar_loss::{Loss, LossError, PlanarLoss, PointCloud, RenderLoss, build_target};
 
 fn main() -> anyhow::Result<()> {
     let args: Vec<String> = std::env::args().collect();
@@ -229,29 +227,14 @@ fn eval(mesh: &Path, state: &Path, evals: usize, term: &str) -> anyhow::Result<(
         Ok(Box::new(PlanarLoss::new(
             &cloud.points,
             &cloud.normals,
-            // The options of `default_loss`.
-            &PlanarOptions {
-                knn: KnnOptions {
-                    k: config.planar_neighbours,
-                    ..KnnOptions::default()
-                },
-                t2s: config.planar_t2s,
-                max_samples: config.planar_max_samples,
-                scale: config.planar_scale,
-                seed: config.seed,
-                ..PlanarOptions::default()
-            },
+            &planar_options(&config),
         )?))
     };
-    let target_options = TargetOptions {
-        views_per_axis: config.views_per_axis,
-        resolution: config.render_resolution,
-        twin_ratio: config.twin_ratio,
-    };
+    let options = target_options(&config);
     let mut loss: Box<dyn Loss> = match term {
         "planar" => planar()?,
         "render" | "all" => {
-            let target = build_target(&soup.positions, &soup.triangles, &target_options)?;
+            let target = build_target(&soup.positions, &soup.triangles, &options)?;
             if term == "render" {
                 Box::new(RenderLoss::new(&target))
             } else {

@@ -431,21 +431,27 @@ mod tests {
         all
     }
 
+    /// `n` random points in [-1, 1]³ with exact duplicates (a quarter) and a flat patch (a
+    /// third at z = 0.25), which stress the tie order and degenerate cells.
+    fn stress_points(rng: &mut ChaCha8Rng, n: usize) -> Vec<DVec3> {
+        let mut points: Vec<DVec3> = (0..n)
+            .map(|_| DVec3::new(rng.random(), rng.random(), rng.random()) * 2.0 - DVec3::ONE)
+            .collect();
+        for i in 0..n / 4 {
+            points[i] = points[n - 1 - i];
+        }
+        for p in points.iter_mut().take(n / 3) {
+            p.z = 0.25;
+        }
+        points
+    }
+
     #[test]
     fn matches_brute_force_in_f32_including_duplicates() {
         let mut rng = ChaCha8Rng::seed_from_u64(3);
         // 40 000 points exercise the parallel build.
         for n in [1usize, 5, 13, 100, 2000, 40_000] {
-            let mut points: Vec<DVec3> = (0..n)
-                .map(|_| DVec3::new(rng.random(), rng.random(), rng.random()) * 2.0 - DVec3::ONE)
-                .collect();
-            // Exact duplicates and a flat patch stress the tie order and degenerate cells.
-            for i in 0..n / 4 {
-                points[i] = points[n - 1 - i];
-            }
-            for p in points.iter_mut().take(n / 3) {
-                p.z = 0.25;
-            }
+            let points = stress_points(&mut rng, n);
             let tree = PointTree::new(&points);
             // One buffer across queries and k: the previous answer seeds each search bound.
             let mut found = Neighbours::default();
@@ -478,15 +484,7 @@ mod tests {
         // gives tight bounds, so the searches start deep in the tree (`start_node`).
         let mut rng = ChaCha8Rng::seed_from_u64(8);
         let n = 3000;
-        let mut points: Vec<DVec3> = (0..n)
-            .map(|_| DVec3::new(rng.random(), rng.random(), rng.random()) * 2.0 - DVec3::ONE)
-            .collect();
-        for i in 0..n / 5 {
-            points[i] = points[n - 1 - i];
-        }
-        for p in points.iter_mut().take(n / 3) {
-            p.z = 0.25;
-        }
+        let points = stress_points(&mut rng, n);
         let tree = PointTree::new(&points);
         let mut found = Neighbours::default();
         let mut hint = None;

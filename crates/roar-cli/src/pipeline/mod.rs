@@ -233,15 +233,7 @@ impl Reconstruction {
         };
 
         report("target", 0, f64::NAN, 0);
-        let target = build_target(
-            positions,
-            triangles,
-            &TargetOptions {
-                views_per_axis: config.views_per_axis,
-                resolution: config.render_resolution,
-                twin_ratio: config.twin_ratio,
-            },
-        )?;
+        let target = build_target(positions, triangles, &target_options(&config))?;
         stats.target_faces = target.triangles.len();
         stats.twins_dropped = target.stats.twins_dropped;
         clock.lap("target");
@@ -399,23 +391,37 @@ impl Reconstruction {
     }
 }
 
+/// The target renders' options of `config` (spec §3.1, §3.2.1), as the pipeline uses them.
+pub fn target_options(config: &ReconstructConfig) -> TargetOptions {
+    TargetOptions {
+        views_per_axis: config.views_per_axis,
+        resolution: config.render_resolution,
+        twin_ratio: config.twin_ratio,
+    }
+}
+
+/// The planar loss options of `config` (spec §3.2.2), as [`default_loss`] uses them.
+pub fn planar_options(config: &ReconstructConfig) -> PlanarOptions {
+    PlanarOptions {
+        knn: KnnOptions {
+            k: config.planar_neighbours,
+            ..KnnOptions::default()
+        },
+        t2s: config.planar_t2s,
+        max_samples: config.planar_max_samples,
+        scale: config.planar_scale,
+        seed: config.seed,
+        ..PlanarOptions::default()
+    }
+}
+
 /// The default objective: `λ1·L_render + λ2·L_planar` (spec §3.2.3).
 pub fn default_loss(prepared: &Prepared) -> Result<Box<dyn Loss>, PipelineError> {
     let config = prepared.config;
     let planar = PlanarLoss::new(
         &prepared.cloud.points,
         &prepared.cloud.normals,
-        &PlanarOptions {
-            knn: KnnOptions {
-                k: config.planar_neighbours,
-                ..KnnOptions::default()
-            },
-            t2s: config.planar_t2s,
-            max_samples: config.planar_max_samples,
-            scale: config.planar_scale,
-            seed: config.seed,
-            ..PlanarOptions::default()
-        },
+        &planar_options(config),
     )?;
     Ok(Box::new(
         WeightedSum::default()

@@ -141,25 +141,12 @@ pub fn limit_steps(
             stats.pair_tests += tests;
             offending.extend_from_slice(&vertices);
         }
-        dirty.iter_mut().for_each(|d| *d = false);
-        offending.sort_unstable();
-        offending.dedup();
-        for &v in &offending {
-            let v = v as usize;
-            let k = halvings[v];
-            if k == u32::MAX {
-                continue; // at its old position already
-            }
-            if k >= options.max_halvings {
-                halvings[v] = u32::MAX;
-                current[v] = before[v];
-                stats.cancelled += 1;
-            } else {
-                halvings[v] = k + 1;
-                current[v] = before[v] + (proposed[v] - before[v]) / f64::from(1u32 << (k + 1));
-            }
-            dirty[v] = true;
-        }
+        let shortening = Shortening {
+            before,
+            proposed,
+            max_halvings: options.max_halvings,
+        };
+        stats.cancelled += shortening.apply(offending, &mut halvings, &mut current, &mut dirty);
     }
     for v in 0..n {
         if halvings[v] != u32::MAX && halvings[v] > 0 {
@@ -168,6 +155,49 @@ pub fn limit_steps(
         proposed[v] = current[v];
     }
     stats
+}
+
+/// The step-shortening rule of [`limit_steps`], shared with its test reference.
+struct Shortening<'a> {
+    before: &'a [DVec3],
+    proposed: &'a [DVec3],
+    max_halvings: u32,
+}
+
+impl Shortening<'_> {
+    /// Halves the step of every vertex of `offending` (repeats allowed) that still differs from
+    /// `before`, or cancels it after `max_halvings` halvings; marks exactly those vertices
+    /// `dirty` (all others clean). Returns the number cancelled.
+    fn apply(
+        &self,
+        mut offending: Vec<u32>,
+        halvings: &mut [u32],
+        current: &mut [DVec3],
+        dirty: &mut [bool],
+    ) -> usize {
+        dirty.iter_mut().for_each(|d| *d = false);
+        offending.sort_unstable();
+        offending.dedup();
+        let mut cancelled = 0;
+        for &v in &offending {
+            let v = v as usize;
+            let k = halvings[v];
+            if k == u32::MAX {
+                continue; // at its old position already
+            }
+            if k >= self.max_halvings {
+                halvings[v] = u32::MAX;
+                current[v] = self.before[v];
+                cancelled += 1;
+            } else {
+                halvings[v] = k + 1;
+                let step = self.proposed[v] - self.before[v];
+                current[v] = self.before[v] + step / f64::from(1u32 << (k + 1));
+            }
+            dirty[v] = true;
+        }
+        cancelled
+    }
 }
 
 /// Dirty faces per rayon task in a pass of [`limit_steps`].
@@ -332,25 +362,12 @@ mod tests {
                     }
                 }
             }
-            dirty.iter_mut().for_each(|d| *d = false);
-            offending.sort_unstable();
-            offending.dedup();
-            for &v in &offending {
-                let v = v as usize;
-                let k = halvings[v];
-                if k == u32::MAX {
-                    continue;
-                }
-                if k >= max_halvings {
-                    halvings[v] = u32::MAX;
-                    current[v] = before[v];
-                    stats.cancelled += 1;
-                } else {
-                    halvings[v] = k + 1;
-                    current[v] = before[v] + (proposed[v] - before[v]) / f64::from(1u32 << (k + 1));
-                }
-                dirty[v] = true;
-            }
+            let shortening = Shortening {
+                before,
+                proposed,
+                max_halvings,
+            };
+            stats.cancelled += shortening.apply(offending, &mut halvings, &mut current, &mut dirty);
         }
         stats.shortened = halvings.iter().filter(|&&k| k != u32::MAX && k > 0).count();
         proposed.copy_from_slice(&current);
