@@ -511,6 +511,7 @@ impl NearFace {
 
     /// The face prepared with its corners at `positions[ids]`: computed at the first call and
     /// kept, so `positions` must not change between calls.
+    #[inline]
     fn prepared(&mut self, positions: &[DVec3]) -> &PreparedFace {
         let ids = self.ids;
         self.prepared
