@@ -86,7 +86,7 @@ impl Mesh {
             return Err(BuildError::UnreferencedVertex { vertex: v as u32 });
         }
 
-        let (corner_he, n_edges) = match_edges(triangles)?;
+        let (corner_he, n_edges) = match_edges(triangles, n_v)?;
 
         let n_he = 2 * n_edges;
         let mut mesh = Mesh {
@@ -187,7 +187,8 @@ fn check_duplicate_faces(triangles: &[[u32; 3]]) -> Result<(), BuildError> {
 ///
 /// Returns, for every corner `3f + k`, the id of its half-edge, and the number of edges. Edge
 /// ids follow the sorted order of the vertex pairs; the half-edge directed low→high gets `2e`.
-fn match_edges(triangles: &[[u32; 3]]) -> Result<(Vec<u32>, usize), BuildError> {
+/// Every index must be `< n_v`.
+fn match_edges(triangles: &[[u32; 3]], n_v: usize) -> Result<(Vec<u32>, usize), BuildError> {
     let n_corners = 3 * triangles.len();
     // (undirected key, corner) with the key's high word the lower vertex.
     let mut keyed: Vec<(u64, u32)> = Vec::with_capacity(n_corners);
@@ -198,7 +199,7 @@ fn match_edges(triangles: &[[u32; 3]]) -> Result<(Vec<u32>, usize), BuildError> 
             keyed.push((key, (3 * f + k) as u32));
         }
     }
-    keyed.sort_unstable();
+    sort_edge_keys(&mut keyed, n_v);
 
     let corner_dir = |corner: u32| -> (u32, u32) {
         let t = triangles[corner as usize / 3];
@@ -270,10 +271,66 @@ fn match_edges(triangles: &[[u32; 3]]) -> Result<(Vec<u32>, usize), BuildError> 
     }
 }
 
+/// Sorts `(key, corner)` pairs whose keys have a vertex index `< n_v` in their high word (as
+/// [`match_edges`] makes them) into increasing order, the order of `sort_unstable`.
+///
+/// A counting sort on the high word, then a comparison sort of each run of equal high words:
+/// the runs hold a vertex's few edges, so this costs `O(n + n_v)` where sorting the whole list
+/// was `O(n log n)` (it was most of the cost of building a large mesh).
+fn sort_edge_keys(keyed: &mut Vec<(u64, u32)>, n_v: usize) {
+    let high = |&(key, _): &(u64, u32)| (key >> 32) as usize;
+    // `start[v]`: where the run of high word `v` begins in the sorted list.
+    let mut start = vec![0usize; n_v + 1];
+    for entry in keyed.iter() {
+        start[high(entry) + 1] += 1;
+    }
+    for v in 0..n_v {
+        start[v + 1] += start[v];
+    }
+    let mut next = start.clone();
+    let mut sorted = vec![(0u64, 0u32); keyed.len()];
+    for entry in keyed.iter() {
+        let slot = &mut next[high(entry)];
+        sorted[*slot] = *entry;
+        *slot += 1;
+    }
+    for v in 0..n_v {
+        sorted[start[v]..start[v + 1]].sort_unstable();
+    }
+    *keyed = sorted;
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::handles::{FaceId, HalfedgeId};
+
+    #[test]
+    fn edge_keys_sort_as_sort_unstable() {
+        use rand::{Rng, SeedableRng};
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(7);
+        for n_v in [1usize, 2, 5, 40] {
+            let mut keyed: Vec<(u64, u32)> = (0..300u32)
+                .map(|corner| {
+                    let (a, b) = (
+                        rng.random_range(0..n_v as u64),
+                        rng.random_range(0..n_v as u64),
+                    );
+                    ((a.min(b) << 32) | a.max(b), corner)
+                })
+                .collect();
+            // Corners in any order, some pairs repeated.
+            keyed.reverse();
+            keyed.extend_from_within(..50);
+            let mut expected = keyed.clone();
+            expected.sort_unstable();
+            sort_edge_keys(&mut keyed, n_v);
+            assert_eq!(keyed, expected);
+        }
+        let mut empty = Vec::new();
+        sort_edge_keys(&mut empty, 3);
+        assert!(empty.is_empty());
+    }
 
     fn tetra() -> (Vec<DVec3>, Vec<[u32; 3]>) {
         let p = vec![

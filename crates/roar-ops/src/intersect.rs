@@ -79,7 +79,8 @@ fn separated_in_projection(
     (tb, pb): ([u32; 3], [DVec3; 3]),
     n_shared: usize,
 ) -> bool {
-    for ((t, pt), (u, pu)) in [((ta, pa), (tb, pb)), ((tb, pb), (ta, pa))] {
+    // By reference: an array of the two orders by value was copied with `memcpy` on every call.
+    for (t, pt, u, pu) in [(&ta, &pa, &tb, &pb), (&tb, &pb, &ta, &pa)] {
         'edges: for k in 0..3 {
             let (p, q, r) = (k, (k + 1) % 3, (k + 2) % 3);
             let on_edge = u.contains(&t[p]) as usize + u.contains(&t[q]) as usize;
@@ -320,14 +321,20 @@ impl PreparedFace {
 /// opposite corner being off the plane), and the other face lies in that plane, so the faces
 /// meet at most there: the fast negatives of [`faces_intersect_filtered`], with the shared
 /// edge case tried both ways.
+///
+/// With distinct ids on both sides, each face has as many corners shared with the other as
+/// the other has with it, and `b` shares all three exactly when it is `a` (so `false`); the
+/// mask of `a`'s shared corners is computed only when the first way fails.
 #[inline]
 pub(crate) fn certainly_apart(a: &PreparedFace, b: &PreparedFace) -> bool {
-    let (shared_a, shared_b) = (a.shared_mask(b), b.shared_mask(a));
-    let valid = a.has_distinct_ids()
-        & b.has_distinct_ids()
-        & (shared_a.count_ones() == shared_b.count_ones())
-        & (shared_b != 0b111);
-    valid && (a.others_strictly_one_side(b, shared_b) || b.others_strictly_one_side(a, shared_a))
+    if !(a.has_distinct_ids() & b.has_distinct_ids()) {
+        return false;
+    }
+    let shared_b = b.shared_mask(a);
+    if shared_b == 0b111 {
+        return false;
+    }
+    a.others_strictly_one_side(b, shared_b) || b.others_strictly_one_side(a, a.shared_mask(b))
 }
 
 /// True if the closed fan of triangles `(apex, rim[i][0], rim[i][1])` certainly has no two faces
@@ -643,6 +650,36 @@ mod tests {
             }
         }
         assert!(certified > off_plane / 2, "{certified} of {off_plane}");
+    }
+
+    /// `certainly_apart` computes the shared-corner masks lazily; it answers as the rule with
+    /// both masks up front did (faces with repeated ids included).
+    #[test]
+    fn certainly_apart_answers_as_with_both_masks_up_front() {
+        let reference = |a: &PreparedFace, b: &PreparedFace| {
+            let (shared_a, shared_b) = (a.shared_mask(b), b.shared_mask(a));
+            let valid = a.has_distinct_ids()
+                & b.has_distinct_ids()
+                & (shared_a.count_ones() == shared_b.count_ones())
+                & (shared_b != 0b111);
+            valid
+                && (a.others_strictly_one_side(b, shared_b)
+                    || b.others_strictly_one_side(a, shared_a))
+        };
+        let mut rng = ChaCha8Rng::seed_from_u64(5);
+        let positions: Vec<DVec3> = (0..6)
+            .map(|_| DVec3::new(rng.random(), rng.random(), rng.random()))
+            .collect();
+        let mut agreed = [0usize; 2];
+        for _ in 0..5000 {
+            let [ta, tb] = [0, 1].map(|_| [0, 1, 2].map(|_| rng.random_range(0..6u32)));
+            let prepare = |t: [u32; 3]| PreparedFace::new(t, t.map(|i| positions[i as usize]));
+            let (a, b) = (prepare(ta), prepare(tb));
+            let answer = certainly_apart(&a, &b);
+            assert_eq!(answer, reference(&a, &b), "{ta:?} {tb:?}");
+            agreed[usize::from(answer)] += 1;
+        }
+        assert!(agreed[0] > 100 && agreed[1] > 100, "{agreed:?}");
     }
 
     /// Random face pairs sharing 0–3 corner ids, on small integer coordinates (many exactly

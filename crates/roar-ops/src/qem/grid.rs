@@ -75,12 +75,15 @@ impl Box32 {
     }
 }
 
-/// A face listed in a bucket, with its corners and rounded box as of its insertion.
+/// A face listed in a bucket, with its corners, rounded box and lowest cell as of its
+/// insertion (the lowest cell decides which cell reports the face in a query; stored so that a
+/// query does not convert the box to cells again for every entry it meets).
 #[derive(Debug, Clone, Copy)]
 struct Entry {
     face: u32,
     corners: [u32; 3],
     bx: Box32,
+    first: Cell,
 }
 
 #[derive(Debug, Clone, Copy)]
@@ -162,12 +165,13 @@ impl FaceGrid {
     pub(crate) fn insert(&mut self, f: u32, corners: [u32; 3], b: &Aabb) {
         self.remove(f);
         let bx = Box32::around(b);
+        let (lo, hi) = self.range(&bx);
         let entry = Entry {
             face: f,
             corners,
             bx,
+            first: lo,
         };
-        let (lo, hi) = self.range(&bx);
         if !bx.is_finite() || Self::count(lo, hi) > MAX_CELLS_PER_FACE {
             self.oversized.push(entry);
             self.slots[f as usize] = Slot::Oversized;
@@ -239,7 +243,7 @@ impl FaceGrid {
             // Every face is listed in the bucket of its lowest cell.
             for (k, list) in self.buckets.iter().enumerate() {
                 for e in list {
-                    if b.overlaps(&e.bx) && self.bucket(self.range(&e.bx).0) == k {
+                    if b.overlaps(&e.bx) && self.bucket(e.first) == k {
                         visit(e.face, &e.bx, e.corners);
                     }
                 }
@@ -251,8 +255,7 @@ impl FaceGrid {
                     for z in lo[2]..=hi[2] {
                         for e in &self.buckets[self.bucket([x, y, z])] {
                             if b.overlaps(&e.bx) {
-                                let first = self.range(&e.bx).0;
-                                let own = [0, 1, 2].map(|k| first[k].max(lo[k]));
+                                let own = [0, 1, 2].map(|k| e.first[k].max(lo[k]));
                                 if own == [x, y, z] {
                                     visit(e.face, &e.bx, e.corners);
                                 }

@@ -456,8 +456,8 @@ struct Decimator<'m, F: FnMut(&Collapse)> {
     fan: Vec<[VertexId; 3]>,
     /// Scratch: the fan's faces after the collapse (relabelled corners) and their boxes.
     fan_scratch: Vec<(PreparedFace, Box32)>,
-    /// Scratch: unmoved faces near the fan, and their boxes.
-    near_scratch: Vec<(PreparedFace, Box32)>,
+    /// Scratch: unmoved faces near the fan.
+    near_scratch: Vec<NearFace>,
     /// Scratch: the rim edges of the fan after the collapse (see [`fan_is_embedded`]).
     rim_scratch: Vec<[DVec3; 2]>,
     collapses: usize,
@@ -485,6 +485,38 @@ fn edge_plane_weight(mesh: &Mesh, h: HalfedgeId, normal: DVec3, options: &Decima
         }
     }
     weight
+}
+
+/// A face the grid query of the intersection veto found near a collapse's fan: its corner ids
+/// and grid box, and, once asked for, the face prepared for the plane tests.
+///
+/// Why lazily: the query covers the box of the whole fan, and most faces it returns overlap no
+/// single fan face's box, so they are never tested; preparing them up front read their corner
+/// positions (scattered, cache misses) and computed their plane minors for nothing.
+#[derive(Debug, Clone, Copy)]
+struct NearFace {
+    ids: [u32; 3],
+    bx: Box32,
+    prepared: Option<PreparedFace>,
+}
+
+impl NearFace {
+    fn new(ids: [u32; 3], bx: Box32) -> NearFace {
+        NearFace {
+            ids,
+            bx,
+            prepared: None,
+        }
+    }
+
+    /// The face prepared with its corners at `positions[ids]`: computed at the first call and
+    /// kept, so `positions` must not change between calls.
+    #[inline]
+    fn prepared(&mut self, positions: &[DVec3]) -> &PreparedFace {
+        let ids = self.ids;
+        self.prepared
+            .get_or_insert_with(|| PreparedFace::new(ids, ids.map(|v| positions[v as usize])))
+    }
 }
 
 /// Corners of `f` as raw ids, and their box.
@@ -790,7 +822,7 @@ impl<'m, F: FnMut(&Collapse)> Decimator<'m, F> {
         if let Some(all) = all {
             grid.query(&all, |_, g_box, ids| {
                 if !in_star(ids) {
-                    near.push((PreparedFace::new(ids, corners_of(ids)), *g_box));
+                    near.push(NearFace::new(ids, *g_box));
                 }
             });
         }
@@ -815,8 +847,8 @@ impl<'m, F: FnMut(&Collapse)> Decimator<'m, F> {
                     break 'fan;
                 }
             }
-            for (other, g_box) in near.iter() {
-                if g_box.overlaps(bx) && meet(tri, other) {
+            for other in near.iter_mut() {
+                if other.bx.overlaps(bx) && meet(tri, other.prepared(positions)) {
                     hit = true;
                     break 'fan;
                 }
@@ -887,6 +919,20 @@ mod tests {
             triangle_quality([DVec3::ZERO, DVec3::X, 2.0 * DVec3::X]),
             f64::INFINITY
         );
+    }
+
+    #[test]
+    fn near_face_is_prepared_once_from_its_corners() {
+        let positions = [DVec3::ZERO, DVec3::X, DVec3::Y, DVec3::Z];
+        let bx = Box32::around(&Aabb::from_triangle([DVec3::ZERO, DVec3::X, DVec3::Z]));
+        let mut near = NearFace::new([0, 1, 3], bx);
+        assert!(near.prepared.is_none());
+        let first = *near.prepared(&positions);
+        assert_eq!(first.ids, [0, 1, 3]);
+        assert_eq!(first.corners, [DVec3::ZERO, DVec3::X, DVec3::Z]);
+        // Kept: a later call does not read the positions again.
+        let moved = [DVec3::ONE; 4];
+        assert_eq!(near.prepared(&moved).corners, first.corners);
     }
 
     #[test]
