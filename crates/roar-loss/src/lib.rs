@@ -19,7 +19,9 @@ pub mod render_loss;
 pub mod sharp_edges;
 pub mod target;
 
-pub use point_cloud::{PointCloud, PointCloudOptions, point_cloud, point_cloud_of_soup};
+pub use point_cloud::{
+    PointCloud, PointCloudOptions, point_cloud, point_cloud_of_soup, two_sided_faces,
+};
 pub use render_loss::RenderLoss;
 pub use sharp_edges::{SharpEdge, SharpEdgeOptions, sharp_edge_samples, sharp_edges};
 pub use target::{Target, TargetOptions, TargetStats, build_target, render_views};

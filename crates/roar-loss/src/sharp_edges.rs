@@ -27,6 +27,9 @@ pub struct SharpEdgeOptions {
     /// The target normal is flipped when its dot with M0's reference normal is below this
     /// (spec: 1e-5).
     pub flip_threshold: f64,
+    /// A sample on a two-sided target face is moved this far along its normal (rig units;
+    /// 0 = off), as in [`crate::PointCloudOptions::sheet_offset`].
+    pub sheet_offset: f64,
     /// Seed of the sampler.
     pub seed: u64,
 }
@@ -37,6 +40,7 @@ impl Default for SharpEdgeOptions {
             samples: 30_000,
             cos_threshold: 0.5,
             flip_threshold: 1e-5,
+            sheet_offset: 0.0,
             seed: 0,
         }
     }
@@ -109,9 +113,13 @@ pub fn sharp_edges(
 /// closed mesh in the same coordinates. Output: `options.samples` points (none if M0 has no
 /// sharp edge or T′ is empty), each the closest point on T′ to a point drawn on a sharp edge,
 /// with the unit normal of the target face it lies on, flipped when its dot with the edge's
-/// reference normal is below `options.flip_threshold`. Deterministic for a given seed.
+/// reference normal is below `options.flip_threshold`. `two_sided[f]` says whether target face
+/// `f` is one side of a sheet ([`crate::point_cloud::two_sided_faces`]; empty = none); samples
+/// on such faces are moved `options.sheet_offset` along their normal. Deterministic for a given
+/// seed.
 pub fn sharp_edge_samples(
     target: &TriangleBvh,
+    two_sided: &[bool],
     m0_positions: &[DVec3],
     m0_triangles: &[[u32; 3]],
     options: &SharpEdgeOptions,
@@ -145,7 +153,12 @@ pub fn sharp_edge_samples(
         if normal.dot(e.reference_normal) < options.flip_threshold {
             normal = -normal;
         }
-        cloud.points.push(hit.point);
+        let offset = if two_sided.get(hit.face as usize) == Some(&true) {
+            options.sheet_offset
+        } else {
+            0.0
+        };
+        cloud.points.push(hit.point + offset * normal);
         cloud.normals.push(normal);
     }
     Ok(cloud)

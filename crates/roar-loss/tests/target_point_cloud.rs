@@ -6,7 +6,7 @@ use common::{Lcg, append, cube, reversed, sphere};
 use glam::DVec3;
 use roar_loss::{
     PointCloud, PointCloudOptions, SharpEdgeOptions, TargetOptions, build_target, point_cloud,
-    point_cloud_of_soup, sharp_edge_samples, sharp_edges,
+    point_cloud_of_soup, sharp_edge_samples, sharp_edges, two_sided_faces,
 };
 use roar_mesh::spatial::{TriangleBvh, closest_point_on_triangle};
 
@@ -130,12 +130,12 @@ fn cube_edges_are_all_sharp_and_samples_land_on_them() {
         seed: 1,
         ..SharpEdgeOptions::default()
     };
-    let samples = sharp_edge_samples(&bvh, &p, &t, &options).unwrap();
+    let samples = sharp_edge_samples(&bvh, &[], &p, &t, &options).unwrap();
     assert_eq!(samples.len(), 3000);
     check_on_edges_with_adjacent_outward_normals(&samples);
     // Same M0, target cube inward-oriented: the flip rule restores outward normals.
     let inward = TriangleBvh::build(&p, &reversed(&t));
-    let flipped = sharp_edge_samples(&inward, &p, &t, &options).unwrap();
+    let flipped = sharp_edge_samples(&inward, &[], &p, &t, &options).unwrap();
     check_on_edges_with_adjacent_outward_normals(&flipped);
     assert_eq!(flipped.points, samples.points);
     // Appending to P.
@@ -178,7 +178,78 @@ fn smooth_meshes_have_no_sharp_edges_and_give_no_samples() {
     let (p, t) = sphere(3, 0.9);
     assert!(sharp_edges(&p, &t, 0.5).unwrap().is_empty());
     let bvh = TriangleBvh::build(&p, &t);
-    let s = sharp_edge_samples(&bvh, &p, &t, &SharpEdgeOptions::default()).unwrap();
+    let s = sharp_edge_samples(&bvh, &[], &p, &t, &SharpEdgeOptions::default()).unwrap();
     assert!(s.is_empty());
     assert!(sharp_edges(&p, &[[0, 1, 999]], 0.5).is_err());
+}
+
+#[test]
+fn two_sided_faces_are_the_ones_whose_reversed_twin_is_there() {
+    let triangles = [
+        [0, 1, 2], // twin below, written from another corner
+        [2, 1, 0],
+        [1, 2, 3], // the same orientation twice is a duplicate, not a sheet
+        [2, 3, 1],
+        [3, 4, 5], // alone
+    ];
+    assert_eq!(
+        two_sided_faces(&triangles),
+        vec![true, true, false, false, false]
+    );
+    assert!(two_sided_faces(&[]).is_empty());
+}
+
+#[test]
+fn sheet_samples_stand_off_on_their_own_side_and_closed_surfaces_stay() {
+    // A square sheet in z = 0 with both orientations, as T′ keeps an open surface.
+    let p = vec![
+        DVec3::new(0.0, 0.0, 0.0),
+        DVec3::new(1.0, 0.0, 0.0),
+        DVec3::new(1.0, 1.0, 0.0),
+        DVec3::new(0.0, 1.0, 0.0),
+    ];
+    let sheet = vec![[0, 1, 2], [0, 2, 3]];
+    let mut t = sheet.clone();
+    t.extend(reversed(&sheet));
+    let offset = 0.01;
+    let options = PointCloudOptions {
+        sheet_offset: offset,
+        ..small_options(7)
+    };
+    let cloud = point_cloud_of_soup(&p, &t, &options).unwrap();
+    let up = cloud.normals.iter().filter(|n| n.z > 0.0).count();
+    assert!(up > 8_000 && cloud.len() - up > 8_000, "both sides kept");
+    for (q, n) in cloud.points.iter().zip(&cloud.normals) {
+        assert!((n.z.abs() - 1.0).abs() < 1e-12);
+        assert!((q.z - offset * n.z).abs() < 1e-12, "{q} with normal {n}");
+    }
+    // A closed cube has no two-sided face: the same options move nothing.
+    let (p, t) = cube(DVec3::ZERO, 0.5);
+    let cloud = point_cloud_of_soup(&p, &t, &options).unwrap();
+    assert!(!cloud.is_empty());
+    assert!(
+        cloud
+            .points
+            .iter()
+            .all(|q| (q.abs().max_element() - 0.5).abs() < 1e-12)
+    );
+}
+
+#[test]
+fn sharp_samples_on_two_sided_faces_stand_off_along_their_normal() {
+    let (p, t) = cube(DVec3::ZERO, 0.5);
+    let bvh = TriangleBvh::build(&p, &t);
+    let options = SharpEdgeOptions {
+        samples: 500,
+        seed: 2,
+        sheet_offset: 0.01,
+        ..SharpEdgeOptions::default()
+    };
+    let plain = sharp_edge_samples(&bvh, &[], &p, &t, &options).unwrap();
+    let moved = sharp_edge_samples(&bvh, &vec![true; t.len()], &p, &t, &options).unwrap();
+    assert_eq!(plain.len(), 500);
+    assert_eq!(moved.normals, plain.normals);
+    for ((a, b), n) in plain.points.iter().zip(&moved.points).zip(&plain.normals) {
+        assert!((*b - (*a + 0.01 * *n)).length() < 1e-12);
+    }
 }

@@ -22,7 +22,7 @@ use glam::DVec3;
 use roar_loss::{
     KnnOptions, KnnPlanarProjector, Loss, LossError, PlanarLoss, PlanarOptions, PointCloud,
     PointCloudOptions, RenderLoss, SharpEdgeOptions, Target, TargetOptions, WeightedSum,
-    build_target, point_cloud, sharp_edge_samples,
+    build_target, point_cloud, sharp_edge_samples, two_sided_faces,
 };
 use roar_mesh::spatial::{Aabb, Normalization, self_intersecting_faces};
 use roar_mesh::{EdgeId, Mesh};
@@ -520,11 +520,15 @@ fn target_cloud(
     m0: &Mesh,
     config: &ReconstructConfig,
 ) -> Result<PointCloud, PipelineError> {
+    let diagonal =
+        Aabb::from_points(target.positions.iter().copied()).map_or(0.0, |b| b.diagonal());
+    let sheet_offset = config.sheet_offset * diagonal;
     let mut cloud = point_cloud(
         target,
         &PointCloudOptions {
             samples: config.point_cloud_samples,
             winding_threshold: config.winding_threshold,
+            sheet_offset,
             seed: config.seed,
             ..PointCloudOptions::default()
         },
@@ -533,10 +537,12 @@ fn target_cloud(
         let (positions, triangles) = m0.to_triangles();
         let sharp = sharp_edge_samples(
             &target.bvh(),
+            &two_sided_faces(&target.triangles),
             &positions,
             &triangles,
             &SharpEdgeOptions {
                 samples: config.sharp_edge_samples,
+                sheet_offset,
                 seed: config.seed,
                 ..SharpEdgeOptions::default()
             },
