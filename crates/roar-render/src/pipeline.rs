@@ -327,7 +327,8 @@ fn backward_view(
 ) -> ViewGrad {
     let m: DMat4 = cam.view_proj();
     let mut d_normals = vec![DVec3::ZERO; normals.len()];
-    let mut d_positions = Vec::new();
+    // At most two entries per item (its edge's endpoints), so the vector never regrows.
+    let mut d_positions = Vec::with_capacity(2 * geom.items.len());
     let ids = &geom.ids;
     let items = &geom.items;
     let mut next = 0;
