@@ -186,11 +186,13 @@ pub fn rasterize(
                 ids[p] = fid;
             }
         };
+        // The row and pixel loops use half-open ranges: an inclusive range carries an extra
+        // "exhausted" flag through every step of these hot loops.
         if (x1 - x0 + 1) * (y1 - y0 + 1) <= SMALL_BOX {
-            for y in y0..=y1 {
+            for y in y0..y1 + 1 {
                 let mut e = row;
                 let z_row = zo32 + zy32 * (y - y0) as f32;
-                for x in x0..=x1 {
+                for x in x0..x1 + 1 {
                     if (e[0] | e[1] | e[2]) >= 0 {
                         let z = z_row + zx32 * (x - x0) as f32;
                         visit(&mut depth, &mut ids, y as usize * w + x as usize, z);
@@ -220,7 +222,7 @@ pub fn rasterize(
         let num_right = edges.iter().filter(|e| e.bound == Bound::Right).count();
         let (left, rest) = edges.split_at_mut(num_left);
         let (right, flat) = rest.split_at_mut(num_right);
-        for y in y0..=y1 {
+        for y in y0..y1 + 1 {
             // The covered pixels of a row form one span (the triangle is convex): intersect the
             // half-lines where each edge function is non-negative, exactly, then only depth-test
             // inside the span.
