@@ -166,7 +166,9 @@ impl KnnPlanarProjector {
                 .items()
                 .map(|(_, j)| (j, self.points[j as usize].distance_squared(p))),
         );
-        found.sort_unstable_by(|a, b| a.1.total_cmp(&b.1).then(a.0.cmp(&b.0)));
+        // Squared distances of finite points are never negative nor NaN, so their bits order
+        // like the numbers (as `total_cmp` would), and one integer key compares each pair.
+        found.sort_unstable_by_key(|&(j, d2)| (d2.to_bits(), j));
     }
 
     /// The move `d` of sample `s` with unit normal `n` (spec §3.2.2 s2t steps 1–3): `None` when
