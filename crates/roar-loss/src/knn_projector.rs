@@ -253,19 +253,18 @@ impl KnnPlanarProjector {
                 })
                 .collect()
         };
-        let in_order = if order.len() <= CHUNK {
-            work(order)
+        // Per chunk, scattered straight from the chunks' vectors (no concatenated copy).
+        let per_chunk: Vec<Vec<Option<DVec3>>> = if order.len() <= CHUNK {
+            vec![work(order)]
         } else {
-            order
-                .par_chunks(CHUNK)
-                .map(work)
-                .collect::<Vec<_>>()
-                .concat()
+            order.par_chunks(CHUNK).map(work).collect()
         };
         let mut result = vec![None; points.len()];
-        for (&i, d) in order.iter().zip(in_order) {
-            if let Some(slot) = result.get_mut(i as usize) {
-                *slot = d;
+        for (chunk, moves) in order.chunks(CHUNK).zip(per_chunk) {
+            for (&i, d) in chunk.iter().zip(moves) {
+                if let Some(slot) = result.get_mut(i as usize) {
+                    *slot = d;
+                }
             }
         }
         result

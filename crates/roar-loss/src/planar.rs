@@ -357,19 +357,18 @@ fn t2s_moves_in_order(
             })
             .collect()
     };
-    let assigned_in_order: Vec<Option<(u32, f64)>> = if order.len() <= CHUNK {
-        assign_chunk(order)
+    // Per chunk, scattered straight from the chunks' vectors (no concatenated copy).
+    let per_chunk: Vec<Vec<Option<(u32, f64)>>> = if order.len() <= CHUNK {
+        vec![assign_chunk(order)]
     } else {
-        order
-            .par_chunks(CHUNK)
-            .map(assign_chunk)
-            .collect::<Vec<_>>()
-            .concat()
+        order.par_chunks(CHUNK).map(assign_chunk).collect()
     };
     let mut assigned: Vec<Option<(u32, f64)>> = vec![None; target_points.len()];
-    for (&j, a) in order.iter().zip(assigned_in_order) {
-        if let Some(slot) = assigned.get_mut(j as usize) {
-            *slot = a;
+    for (chunk, answers) in order.chunks(CHUNK).zip(per_chunk) {
+        for (&j, a) in chunk.iter().zip(answers) {
+            if let Some(slot) = assigned.get_mut(j as usize) {
+                *slot = a;
+            }
         }
     }
     let mut farthest: Vec<Option<(usize, f64)>> = vec![None; samples.len()];
