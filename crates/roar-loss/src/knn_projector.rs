@@ -166,7 +166,9 @@ impl KnnPlanarProjector {
                 .items()
                 .map(|(_, j)| (j, self.points[j as usize].distance_squared(p))),
         );
-        found.sort_unstable_by(|a, b| a.1.total_cmp(&b.1).then(a.0.cmp(&b.0)));
+        // Squared distances of finite points are never negative nor NaN, so their bits order
+        // like the numbers (as `total_cmp` would), and one integer key compares each pair.
+        found.sort_unstable_by_key(|&(j, d2)| (d2.to_bits(), j));
     }
 
     /// The move `d` of sample `s` with unit normal `n` (spec §3.2.2 s2t steps 1–3): `None` when
@@ -224,6 +226,48 @@ impl KnnPlanarProjector {
             .map(|(c, chunk)| work(c * CHUNK, chunk))
             .collect::<Vec<_>>()
             .concat()
+    }
+}
+
+impl KnnPlanarProjector {
+    /// [`KnnPlanarProjector::displacements`] of the samples listed in `order` (indices into
+    /// `points`, each at most once), searched in that order; samples not listed get `None`.
+    /// Each answer depends on its own sample only, so the result equals `displacements` at the
+    /// listed samples; a spatially coherent order makes every search's bound (the previous
+    /// answer of the chunk) tight, which is cheaper than the samples' face order, whose
+    /// consecutive faces can lie far apart.
+    pub(crate) fn displacements_in_order(
+        &self,
+        points: &[DVec3],
+        normals: &[DVec3],
+        order: &[u32],
+    ) -> Vec<Option<DVec3>> {
+        let work = |chunk: &[u32]| -> Vec<Option<DVec3>> {
+            let mut scratch = Neighbours::default();
+            let mut found = Vec::with_capacity(self.options.k);
+            chunk
+                .iter()
+                .map(|&i| {
+                    let (s, n) = (points.get(i as usize)?, normals.get(i as usize)?);
+                    self.displacement_into(*s, *n, &mut scratch, &mut found)
+                })
+                .collect()
+        };
+        // Per chunk, scattered straight from the chunks' vectors (no concatenated copy).
+        let per_chunk: Vec<Vec<Option<DVec3>>> = if order.len() <= CHUNK {
+            vec![work(order)]
+        } else {
+            order.par_chunks(CHUNK).map(work).collect()
+        };
+        let mut result = vec![None; points.len()];
+        for (chunk, moves) in order.chunks(CHUNK).zip(per_chunk) {
+            for (&i, d) in chunk.iter().zip(moves) {
+                if let Some(slot) = result.get_mut(i as usize) {
+                    *slot = d;
+                }
+            }
+        }
+        result
     }
 }
 
@@ -314,6 +358,48 @@ mod tests {
         let d = proj.displacement(s, n).unwrap();
         assert!((s + d).z.abs() < 1e-12);
         assert!(d.cross(n).length() < 1e-12);
+    }
+
+    #[test]
+    fn displacements_in_any_order_match_the_plain_ones() {
+        // A wavy target and samples above it, more than one parallel chunk of each; some
+        // samples non-finite, some normals missing.
+        let grid = |n: usize, z: f64| -> Vec<DVec3> {
+            (0..n * n)
+                .map(|i| {
+                    let (x, y) = ((i % n) as f64 / n as f64, (i / n) as f64 / n as f64);
+                    DVec3::new(x, y, z + 0.05 * (7.0 * x).sin() * (5.0 * y).cos())
+                })
+                .collect()
+        };
+        let target = grid(60, 0.0);
+        let target_normals = vec![DVec3::new(0.1, -0.2, 1.0); target.len()];
+        let proj =
+            KnnPlanarProjector::new(&target, &target_normals, &KnnOptions::default()).unwrap();
+        let mut samples = grid(70, 0.02);
+        samples[5] = DVec3::splat(f64::NAN);
+        let normals = vec![DVec3::new(0.0, 0.3, 1.0).normalize(); samples.len() - 3];
+        let plain = proj.displacements(&samples, &normals);
+        assert!(plain.iter().filter(|d| d.is_some()).count() > samples.len() / 2);
+        // Every seventh sample in a scrambled order, then all of them in reverse.
+        let n = samples.len() as u32;
+        // (2654435761 is prime to n = 4900, so the map is a permutation.)
+        let scrambled: Vec<u32> = (0..n as u64)
+            .map(|i| (i * 2654435761 % n as u64) as u32)
+            .step_by(7)
+            .collect();
+        let reversed: Vec<u32> = (0..n).rev().collect();
+        for order in [scrambled, reversed] {
+            let got = proj.displacements_in_order(&samples, &normals, &order);
+            for i in 0..samples.len() {
+                let expected = if order.contains(&(i as u32)) {
+                    plain[i]
+                } else {
+                    None
+                };
+                assert_eq!(got[i], expected, "sample {i}");
+            }
+        }
     }
 
     #[test]

@@ -144,13 +144,17 @@ impl PlanarLoss {
     /// The moves `d_i` of the given samples (s2t, combined with t2s when enabled): `None` when
     /// neither term gives a valid move. Deterministic.
     pub fn moves(&self, points: &[DVec3], normals: &[DVec3]) -> Vec<Option<DVec3>> {
-        let s2t = self.projector.displacements(points, normals);
         if !self.options.t2s {
-            return s2t;
+            return self.projector.displacements(points, normals);
         }
+        let tree = SampleTree::new(points);
+        let s2t = self
+            .projector
+            .displacements_in_order(points, normals, &tree.spatial_order());
         let t2s = t2s_moves_in_order(
             points,
             normals,
+            &tree,
             self.projector.points(),
             self.projector.normals(),
             self.options.t2s_normal_dot,
@@ -193,11 +197,16 @@ impl Loss for PlanarLoss {
             generated,
         } = self.draw_samples(positions, triangles);
 
-        let s2t = self.projector.displacements(&points, &normals);
         let (moves, from_t2s) = if self.options.t2s {
+            // The t2s tree over the samples also gives s2t a coherent search order.
+            let tree = SampleTree::new(&points);
+            let s2t =
+                self.projector
+                    .displacements_in_order(&points, &normals, &tree.spatial_order());
             let t2s = t2s_moves_in_order(
                 &points,
                 &normals,
+                &tree,
                 self.projector.points(),
                 self.projector.normals(),
                 self.options.t2s_normal_dot,
@@ -210,7 +219,7 @@ impl Loss for PlanarLoss {
                 .count();
             (combine_moves(&s2t, &t2s), from_t2s)
         } else {
-            (s2t, 0)
+            (self.projector.displacements(&points, &normals), 0)
         };
         let targets: Vec<Option<DVec3>> = moves
             .iter()
@@ -276,6 +285,7 @@ pub fn t2s_moves(
     t2s_moves_in_order(
         samples,
         sample_normals,
+        &SampleTree::new(samples),
         target_points,
         target_normals,
         normal_dot,
@@ -283,25 +293,52 @@ pub fn t2s_moves(
     )
 }
 
-/// [`t2s_moves`] visiting the target points in `order` (a permutation of their indices; a
-/// spatially coherent one makes the searches cheaper, the result does not depend on it).
+/// The kd-tree over the finite samples of one evaluation (the t2s searches run in it).
+struct SampleTree {
+    /// Sample index of each tree point.
+    finite: Vec<usize>,
+    tree: PointTree,
+}
+
+impl SampleTree {
+    fn new(samples: &[DVec3]) -> Self {
+        let finite: Vec<usize> = (0..samples.len())
+            .filter(|&i| samples[i].is_finite())
+            .collect();
+        let finite_points: Vec<DVec3> = finite.iter().map(|&i| samples[i]).collect();
+        Self {
+            tree: PointTree::new(&finite_points),
+            finite,
+        }
+    }
+
+    /// The finite samples' indices in the tree's leaf order (spatially coherent).
+    fn spatial_order(&self) -> Vec<u32> {
+        self.tree
+            .spatial_order()
+            .iter()
+            .map(|&local| self.finite[local as usize] as u32)
+            .collect()
+    }
+}
+
+/// [`t2s_moves`] with the samples' `tree` (built over `samples`), visiting the target points
+/// in `order` (a permutation of their indices; a spatially coherent one makes the searches
+/// cheaper, the result does not depend on it).
 fn t2s_moves_in_order(
     samples: &[DVec3],
     sample_normals: &[DVec3],
+    tree: &SampleTree,
     target_points: &[DVec3],
     target_normals: &[DVec3],
     normal_dot: f64,
     order: &[u32],
 ) -> Vec<Option<DVec3>> {
     let mut result = vec![None; samples.len()];
-    let finite: Vec<usize> = (0..samples.len())
-        .filter(|&i| samples[i].is_finite())
-        .collect();
+    let SampleTree { finite, tree } = tree;
     if finite.is_empty() || target_points.is_empty() {
         return result;
     }
-    let finite_points: Vec<DVec3> = finite.iter().map(|&i| samples[i]).collect();
-    let tree = PointTree::new(&finite_points);
     // Each target point goes to its nearest sample; the previous answer of the chunk bounds the
     // next search (it never changes the answer).
     let assign_chunk = |chunk: &[u32]| -> Vec<Option<(u32, f64)>> {
@@ -320,19 +357,18 @@ fn t2s_moves_in_order(
             })
             .collect()
     };
-    let assigned_in_order: Vec<Option<(u32, f64)>> = if order.len() <= CHUNK {
-        assign_chunk(order)
+    // Per chunk, scattered straight from the chunks' vectors (no concatenated copy).
+    let per_chunk: Vec<Vec<Option<(u32, f64)>>> = if order.len() <= CHUNK {
+        vec![assign_chunk(order)]
     } else {
-        order
-            .par_chunks(CHUNK)
-            .map(assign_chunk)
-            .collect::<Vec<_>>()
-            .concat()
+        order.par_chunks(CHUNK).map(assign_chunk).collect()
     };
     let mut assigned: Vec<Option<(u32, f64)>> = vec![None; target_points.len()];
-    for (&j, a) in order.iter().zip(assigned_in_order) {
-        if let Some(slot) = assigned.get_mut(j as usize) {
-            *slot = a;
+    for (chunk, answers) in order.chunks(CHUNK).zip(per_chunk) {
+        for (&j, a) in chunk.iter().zip(answers) {
+            if let Some(slot) = assigned.get_mut(j as usize) {
+                *slot = a;
+            }
         }
     }
     let mut farthest: Vec<Option<(usize, f64)>> = vec![None; samples.len()];

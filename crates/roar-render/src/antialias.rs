@@ -118,14 +118,16 @@ pub fn silhouette_masks(
         .iter()
         .zip(&neighbors.opposite)
         .map(|(tri, opposite)| {
+            // Each corner is read once for the three edges.
+            let corner = tri.map(xy);
             let mut mask = 0u8;
             for k in 0..3 {
                 let silhouette = if opposite[k] == NO_NEIGHBOR {
                     true
                 } else {
-                    let a = xy(tri[k]);
-                    let b = xy(tri[(k + 1) % 3]);
-                    let own = edge_fn(a, b, xy(tri[(k + 2) % 3]));
+                    let a = corner[k];
+                    let b = corner[(k + 1) % 3];
+                    let own = edge_fn(a, b, corner[(k + 2) % 3]);
                     let other = edge_fn(a, b, xy(opposite[k]));
                     own * other >= 0.0
                 };
@@ -274,11 +276,12 @@ impl PairContext<'_> {
         let mut found = None;
         for _ in 0..MAX_WALK {
             let tri = self.triangles[face as usize];
+            let corner = tri.map(|v| self.xy(v));
             let mut best: Option<(usize, f64)> = None;
             for k in 0..3 {
-                let a = self.xy(tri[k]);
-                let b = self.xy(tri[(k + 1) % 3]);
-                let orient = edge_fn(a, b, self.xy(tri[(k + 2) % 3]));
+                let a = corner[k];
+                let b = corner[(k + 1) % 3];
+                let orient = edge_fn(a, b, corner[(k + 2) % 3]);
                 let (ef, eo) = (edge_fn(a, b, cf) * orient, edge_fn(a, b, co) * orient);
                 if ef > eo {
                     let t = ef / (ef - eo);

@@ -22,9 +22,16 @@ pub enum LossKind {
 pub fn loss_term(kind: LossKind, d: f64) -> (f64, f64) {
     match kind {
         LossKind::L1 => {
-            // sign(d) with sign(0) = 0, without branches (this runs for every pixel channel).
-            let s = (d > 0.0) as i32 - (d < 0.0) as i32;
-            (d.abs(), s as f64)
+            // sign(d) with sign(0) = +0 (and NaN), as a select of constants: no integer round
+            // trip in this per-channel hot path.
+            let s = if d > 0.0 {
+                1.0
+            } else if d < 0.0 {
+                -1.0
+            } else {
+                0.0
+            };
+            (d.abs(), s)
         }
         LossKind::L2 => (d * d, 2.0 * d),
     }
@@ -90,5 +97,21 @@ mod tests {
             }
         }
         assert_eq!(loss_term(LossKind::L1, 0.0), (0.0, 0.0));
+        // The L1 slope is exactly ±1, and +0 at zero (either sign) and NaN.
+        assert_eq!(
+            loss_term(LossKind::L1, -3e-300).1.to_bits(),
+            (-1.0f64).to_bits()
+        );
+        assert_eq!(
+            loss_term(LossKind::L1, 5e-324).1.to_bits(),
+            1.0f64.to_bits()
+        );
+        for d in [0.0, -0.0, f64::NAN] {
+            assert_eq!(
+                loss_term(LossKind::L1, d).1.to_bits(),
+                0.0f64.to_bits(),
+                "{d}"
+            );
+        }
     }
 }

@@ -181,17 +181,154 @@ struct ViewGrad {
     d_positions: Vec<(u32, DVec3)>,
 }
 
-/// Backward of one view given a seed `seed(pixel, colour) -> dL/dI` (which may also accumulate
-/// a loss). Every pixel is seeded once, in pixel order.
+/// Where a view's backward pass gets `dL/dI` from (which may also accumulate a loss).
+trait Seed {
+    /// `dL/dI` of pixel `p`, which shows colour `img`.
+    fn pixel(&mut self, p: usize, img: [f64; 4]) -> [f64; 4];
+
+    /// Seeds the unblended pixels `start..start + ids.len()`, which show the colours of the
+    /// faces `ids`, and adds each covered pixel's colour gradient to its face's entry of
+    /// `d_normals`, pixel by pixel in order. Implementations must give the bits of this default
+    /// (one [`Seed::pixel`] call per pixel, in order); they exist to be cheaper.
+    fn unblended(&mut self, start: usize, ids: &[u32], normals: &[DVec3], d_normals: &mut [DVec3]) {
+        for (q, &id) in (start..).zip(ids) {
+            let g = self.pixel(q, colour(normals, id));
+            if id != BACKGROUND {
+                d_normals[id as usize] += DVec3::new(g[0], g[1], g[2]);
+            }
+        }
+    }
+}
+
+/// Whether all four channels are zero (either sign), without the slice comparison's loop.
+#[inline]
+fn is_zero(c: [f32; 4]) -> bool {
+    (c[0] == 0.0) & (c[1] == 0.0) & (c[2] == 0.0) & (c[3] == 0.0)
+}
+
+/// Pixels tested at once for background over a zero target.
+const BLANK_BLOCK: usize = 8;
+
+/// Whether every pixel shows the background and every target channel is zero (either sign):
+/// such pixels add no loss and no gradient. Takes [`BLANK_BLOCK`] pixels (shorter slices are
+/// never blank); one OR over the bits (sign bits masked) instead of a branch per pixel.
+#[inline]
+fn is_blank(ids: &[u32], target: &[[f32; 4]]) -> bool {
+    let (Ok(ids), Ok(target)) = (
+        <&[u32; BLANK_BLOCK]>::try_from(ids),
+        <&[[f32; 4]; BLANK_BLOCK]>::try_from(target),
+    ) else {
+        return false;
+    };
+    let mut any = 0u32;
+    for k in 0..BLANK_BLOCK {
+        any |= ids[k] ^ BACKGROUND;
+        for c in target[k] {
+            any |= c.to_bits() & 0x7fff_ffff;
+        }
+    }
+    any == 0
+}
+
+/// A given image gradient (the unfused [`backward`]).
+struct ImageSeed<'a> {
+    d_image: &'a [[f64; 4]],
+}
+
+impl Seed for ImageSeed<'_> {
+    fn pixel(&mut self, p: usize, _img: [f64; 4]) -> [f64; 4] {
+        self.d_image[p]
+    }
+}
+
+/// The image loss against a target image, summed into `loss` pixel by pixel and channel by
+/// channel; `penalty(d) = (loss, dloss/dd)` per channel difference `d = I − T`, gradients
+/// scaled by `inv_n` (the mean's `1/N`).
+struct TargetSeed<'a, P> {
+    target: &'a [[f32; 4]],
+    inv_n: f64,
+    penalty: P,
+    loss: f64,
+}
+
+impl<P: Fn(f64) -> (f64, f64)> Seed for TargetSeed<'_, P> {
+    fn pixel(&mut self, p: usize, img: [f64; 4]) -> [f64; 4] {
+        let t = self.target[p];
+        if img == [0.0; 4] && t == [0.0; 4] {
+            // Background over background (a third of a typical view): no loss, no gradient.
+            return [0.0; 4];
+        }
+        let mut g = [0.0; 4];
+        for c in 0..4 {
+            let (l, d) = (self.penalty)(img[c] - t[c] as f64);
+            self.loss += l;
+            g[c] = d * self.inv_n;
+        }
+        g
+    }
+
+    /// The default's arithmetic, in the same order, per run of equal ids: the colour is read
+    /// once per run and the run's face-normal gradient is summed in a register (the same
+    /// additions, in the same order, as adding into `d_normals` pixel by pixel). Background
+    /// pixels skip the gradient, which the default discards.
+    fn unblended(&mut self, start: usize, ids: &[u32], normals: &[DVec3], d_normals: &mut [DVec3]) {
+        let target = &self.target[start..start + ids.len()];
+        let mut loss = self.loss;
+        let mut i = 0;
+        while i < ids.len() {
+            let id = ids[i];
+            if id == BACKGROUND {
+                while i < ids.len() && ids[i] == BACKGROUND {
+                    if let (Some(block_ids), Some(block_target)) =
+                        (ids.get(i..i + BLANK_BLOCK), target.get(i..i + BLANK_BLOCK))
+                        && is_blank(block_ids, block_target)
+                    {
+                        i += BLANK_BLOCK;
+                        continue;
+                    }
+                    let t = target[i];
+                    i += 1;
+                    if is_zero(t) {
+                        continue;
+                    }
+                    for tc in t {
+                        loss += (self.penalty)(0.0 - tc as f64).0;
+                    }
+                }
+                continue;
+            }
+            let img = colour(normals, id);
+            let mut acc = d_normals[id as usize];
+            while i < ids.len() && ids[i] == id {
+                let t = target[i];
+                i += 1;
+                let mut g = [0.0; 3];
+                for c in 0..4 {
+                    let (l, d) = (self.penalty)(img[c] - t[c] as f64);
+                    loss += l;
+                    if c < 3 {
+                        g[c] = d * self.inv_n;
+                    }
+                }
+                acc += DVec3::new(g[0], g[1], g[2]);
+            }
+            d_normals[id as usize] = acc;
+        }
+        self.loss = loss;
+    }
+}
+
+/// Backward of one view given its `seed`. Every pixel is seeded once, in pixel order.
 fn backward_view(
     geom: &ViewGeometry,
     cam: &Camera,
     normals: &[DVec3],
-    mut seed: impl FnMut(usize, [f64; 4]) -> [f64; 4],
+    seed: &mut impl Seed,
 ) -> ViewGrad {
     let m: DMat4 = cam.view_proj();
     let mut d_normals = vec![DVec3::ZERO; normals.len()];
-    let mut d_positions = Vec::new();
+    // At most two entries per item (its edge's endpoints), so the vector never regrows.
+    let mut d_positions = Vec::with_capacity(2 * geom.items.len());
     let ids = &geom.ids;
     let items = &geom.items;
     let mut next = 0;
@@ -200,12 +337,7 @@ fn backward_view(
         // Pixels up to the next AA target show their own face's colour unblended: the image
         // gradient goes to that face's normal only.
         let blended = items.get(next).map_or(ids.len(), |it| it.target as usize);
-        for (q, &id) in (p..).zip(&ids[p..blended]) {
-            let g = seed(q, colour(normals, id));
-            if id != BACKGROUND {
-                d_normals[id as usize] += DVec3::new(g[0], g[1], g[2]);
-            }
-        }
+        seed.unblended(p, &ids[p..blended], normals, &mut d_normals);
         if blended == ids.len() {
             break;
         }
@@ -224,7 +356,7 @@ fn backward_view(
                 img[c] += it.alpha * (src[c] - base[c]);
             }
         }
-        let g = seed(p, img);
+        let g = seed.pixel(p, img);
         p += 1;
         if g == [0.0; 4] {
             continue;
@@ -394,8 +526,10 @@ pub fn backward(
             depth: Vec::new(),
             items: view.aa.clone(),
         };
-        let d = &d_image[v];
-        Ok(backward_view(&geom, cam, &normals, |p, _| d[p]))
+        let mut seed = ImageSeed {
+            d_image: &d_image[v],
+        };
+        Ok(backward_view(&geom, cam, &normals, &mut seed))
     })?;
     Ok(grad)
 }
@@ -459,22 +593,14 @@ fn view_loss_and_grad(
     inv_n: f64,
     penalty: impl Fn(f64) -> (f64, f64),
 ) -> ViewGrad {
-    let mut loss = 0.0;
-    let mut r = backward_view(geom, cam, normals, |p, img| {
-        let t = target[p];
-        if img == [0.0; 4] && t == [0.0; 4] {
-            // Background over background (a third of a typical view): no loss, no gradient.
-            return [0.0; 4];
-        }
-        let mut g = [0.0; 4];
-        for c in 0..4 {
-            let (l, d) = penalty(img[c] - t[c] as f64);
-            loss += l;
-            g[c] = d * inv_n;
-        }
-        g
-    });
-    r.loss = loss;
+    let mut seed = TargetSeed {
+        target,
+        inv_n,
+        penalty,
+        loss: 0.0,
+    };
+    let mut r = backward_view(geom, cam, normals, &mut seed);
+    r.loss = seed.loss;
     r
 }
 
@@ -508,4 +634,100 @@ pub fn to_rgba8(image: &[[f32; 4]]) -> Vec<u8> {
         }
     }
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// [`TargetSeed`] with the trait's default `unblended`, the reference for its override.
+    struct PerPixel<'a, P>(TargetSeed<'a, P>);
+
+    impl<P: Fn(f64) -> (f64, f64)> Seed for PerPixel<'_, P> {
+        fn pixel(&mut self, p: usize, img: [f64; 4]) -> [f64; 4] {
+            self.0.pixel(p, img)
+        }
+    }
+
+    /// Tiny deterministic generator (xorshift) in [0, 1).
+    fn next(state: &mut u64) -> f64 {
+        *state ^= *state << 13;
+        *state ^= *state >> 7;
+        *state ^= *state << 17;
+        (*state >> 11) as f64 / (1u64 << 53) as f64
+    }
+
+    #[test]
+    fn blank_blocks_are_background_over_zero_targets() {
+        let ids = [BACKGROUND; BLANK_BLOCK];
+        let zero = [[0.0f32; 4]; BLANK_BLOCK];
+        assert!(is_blank(&ids, &zero));
+        let mut signed = zero;
+        signed[3] = [-0.0, 0.0, -0.0, -0.0];
+        assert!(is_blank(&ids, &signed));
+        assert!(!is_blank(&ids[1..], &zero[1..]));
+        for k in 0..BLANK_BLOCK {
+            let mut covered = ids;
+            covered[k] = 0;
+            assert!(!is_blank(&covered, &zero));
+            for (c, value) in [(0, 1e-40), (3, -1.0), (2, f32::NAN)] {
+                let mut target = zero;
+                target[k][c] = value;
+                assert!(!is_blank(&ids, &target), "{k} {c}");
+            }
+        }
+    }
+
+    #[test]
+    fn run_seeding_gives_the_bits_of_per_pixel_seeding() {
+        let mut state = 0x2545_f491_4f6c_dd1du64;
+        let normals: Vec<DVec3> = (0..5)
+            .map(|_| DVec3::new(next(&mut state), next(&mut state), next(&mut state)) - 0.5)
+            .collect();
+        for case in 0..50 {
+            // Runs of faces and background (long enough for blank blocks), targets zero (most
+            // of the background), equal to the rendered colour, or random.
+            let n = 1 + case * 7;
+            let mut ids = Vec::new();
+            while ids.len() < n {
+                let id = match (next(&mut state) * 7.0) as u32 {
+                    k @ 0..=4 => k,
+                    _ => BACKGROUND,
+                };
+                let len = 1 + (next(&mut state) * 20.0) as usize;
+                ids.extend(std::iter::repeat_n(id, len));
+            }
+            ids.truncate(n);
+            let target: Vec<[f32; 4]> = ids
+                .iter()
+                .map(|&id| match (next(&mut state) * 3.0) as u32 {
+                    _ if id == BACKGROUND && next(&mut state) < 0.8 => [0.0; 4],
+                    0 => [0.0; 4],
+                    1 => colour(&normals, id).map(|c| c as f32),
+                    _ => [0; 4].map(|_| next(&mut state) as f32 - 0.5),
+                })
+                .collect();
+            let start = case % 3;
+            let target = [vec![[0.25; 4]; start], target].concat();
+            for kind in [LossKind::L1, LossKind::L2] {
+                let penalty = |d| loss_term(kind, d);
+                let seed = |loss| TargetSeed {
+                    target: &target,
+                    inv_n: 1.0 / 3.0,
+                    penalty,
+                    loss,
+                };
+                let initial: Vec<DVec3> = normals.iter().map(|n| *n * 0.1).collect();
+                let (mut runs, mut per_pixel) = (seed(0.5), PerPixel(seed(0.5)));
+                let (mut d_runs, mut d_pixels) = (initial.clone(), initial);
+                runs.unblended(start, &ids, &normals, &mut d_runs);
+                per_pixel.unblended(start, &ids, &normals, &mut d_pixels);
+                assert_eq!(runs.loss.to_bits(), per_pixel.0.loss.to_bits(), "{case}");
+                let bits = |d: &[DVec3]| -> Vec<[u64; 3]> {
+                    d.iter().map(|v| v.to_array().map(f64::to_bits)).collect()
+                };
+                assert_eq!(bits(&d_runs), bits(&d_pixels), "case {case} {kind:?}");
+            }
+        }
+    }
 }
