@@ -12,8 +12,13 @@
 //!   every value and gradient, which changes if any output bit changes.
 //!
 //! With env `SINGLE=1` everything runs in a one-thread rayon pool on the main thread, so that
-//! `SINGLE=1 valgrind --tool=callgrind --collect-atstart=no --toggle-collect='*value_and_grad*'`
-//! counts the instructions of the evaluations only.
+//! `SINGLE=1 valgrind --tool=callgrind --collect-atstart=no --toggle-collect=PATTERN` counts the
+//! instructions of the evaluations only. `PATTERN` must match the outermost loss only:
+//! `--toggle-collect` flips collection on entry and exit of every matching function, so a
+//! pattern like `*value_and_grad*` that also matches the nested terms switches collection off
+//! again inside them and counts almost nothing. Use `'*WeightedSum*value_and_grad*'` for
+//! `all`, `'*RenderLoss*value_and_grad*'` for `render` and `'*PlanarLoss*value_and_grad*'`
+//! for `planar`.
 
 use std::io::{Read, Write};
 use std::path::Path;

@@ -100,13 +100,6 @@ impl Neighbours {
         self.bound = limit;
     }
 
-    /// The squared distance a point must not exceed to enter: the limit until `k` are found,
-    /// then the current `k`-th distance (never above the limit).
-    #[inline]
-    fn bound(&self) -> f32 {
-        self.bound
-    }
-
     /// Inserts `(d2, id)` if it is among the `k` best so far (ties broken by smaller index).
     #[inline]
     fn offer(&mut self, d2: f32, id: u32) {
@@ -306,7 +299,7 @@ impl PointTree {
             return;
         }
         let start = self.start_node(&q, limit);
-        self.search(start, &q, [0.0; 3], 0.0, found);
+        self.search(start, &q, found);
     }
 
     /// The nearest point of `query` (ties: smaller index); `None` for an empty tree. `hint`, a
@@ -320,9 +313,9 @@ impl PointTree {
             .and_then(|id| self.coords_by_id.get(id as usize))
             .map_or(f32::INFINITY, |c| distance2(c, &q));
         // Starts at (limit, u32::MAX): the hint itself always qualifies, so `best` is filled.
-        let mut best = (limit, u32::MAX);
+        let mut best = Nearest(limit, u32::MAX);
         let start = self.start_node(&q, limit);
-        self.search_one(start, &q, [0.0; 3], 0.0, &mut best);
+        self.search(start, &q, &mut best);
         Some(best.1)
     }
 
@@ -348,38 +341,6 @@ impl PointTree {
         }
     }
 
-    /// [`PointTree::search`] for a single neighbour `best = (d2, id)`, without the buffer.
-    fn search_one(&self, node: u32, q: &[f32; 3], off: [f32; 3], rd: f32, best: &mut (f32, u32)) {
-        let nd = self.nodes[node as usize];
-        if nd.axis == LEAF {
-            let d2 = self.leaf_distances(nd, q);
-            let mut mask = within(&d2, best.0);
-            while mask != 0 {
-                let i = mask.trailing_zeros() as usize;
-                mask &= mask - 1;
-                let id = self.leaf_ids[nd.start as usize + i];
-                if d2[i] < best.0 || (d2[i] == best.0 && id < best.1) {
-                    *best = (d2[i], id);
-                }
-            }
-            return;
-        }
-        let axis = nd.axis as usize;
-        let diff = q[axis] - nd.split;
-        let (near, far) = if diff < 0.0 {
-            (node + 1, nd.right)
-        } else {
-            (nd.right, node + 1)
-        };
-        self.search_one(near, q, off, rd, best);
-        let far_rd = rd - off[axis] * off[axis] + diff * diff;
-        if far_rd <= best.0 * PRUNE_SLACK {
-            let mut far_off = off;
-            far_off[axis] = diff;
-            self.search_one(far, q, far_off, far_rd, best);
-        }
-    }
-
     /// Squared distances from `q` to the slots of leaf `leaf` (NaN for padding).
     #[inline]
     fn leaf_distances(&self, leaf: Node, q: &[f32; 3]) -> [f32; LEAF_SIZE] {
@@ -397,32 +358,114 @@ impl PointTree {
         out
     }
 
-    /// Visits `node` whose cell lies at squared distance `rd` (per-axis offsets `off`).
-    fn search(&self, node: u32, q: &[f32; 3], off: [f32; 3], rd: f32, found: &mut Neighbours) {
-        let nd = self.nodes[node as usize];
-        if nd.axis == LEAF {
-            let d2 = self.leaf_distances(nd, q);
-            let mut mask = within(&d2, found.bound());
-            while mask != 0 {
-                let i = mask.trailing_zeros() as usize;
-                mask &= mask - 1;
-                found.offer(d2[i], self.leaf_ids[nd.start as usize + i]);
+    /// Depth-first search of the subtree at `start` (whose cell holds `q`, so at distance 0):
+    /// each inner node visits its child on `q`'s side first, then the other child if that
+    /// cell's squared distance is within `found`'s bound (with [`PRUNE_SLACK`]) at that time;
+    /// every visited leaf goes to `found`.
+    ///
+    /// The far children wait on a fixed stack instead of in recursive calls, whose entry,
+    /// argument passing and exit cost more than the node test itself; the visiting order and
+    /// every pruning decision are those of the recursion. A pending far child is pushed per
+    /// inner level of the descent, and median splits halve the points per level, so a tree
+    /// over fewer than 2³² points never holds more than [`MAX_PENDING`] of them.
+    fn search<C: Collector>(&self, start: u32, q: &[f32; 3], found: &mut C) {
+        // (node, per-axis cell offsets, squared cell distance)
+        let mut pending = [(0u32, [0.0f32; 3], 0.0f32); MAX_PENDING];
+        let mut len = 0;
+        let (mut node, mut off, mut rd) = (start, [0.0f32; 3], 0.0f32);
+        loop {
+            let nd = self.nodes[node as usize];
+            if nd.axis != LEAF {
+                let axis = nd.axis as usize;
+                let diff = q[axis] - nd.split;
+                let (near, far) = if diff < 0.0 {
+                    (node + 1, nd.right)
+                } else {
+                    (nd.right, node + 1)
+                };
+                let far_rd = rd - off[axis] * off[axis] + diff * diff;
+                // The bound never grows, so a far cell beyond it now is beyond it when its
+                // turn comes: skipping it here makes the same decision sooner.
+                if far_rd <= found.bound() * PRUNE_SLACK {
+                    let mut far_off = off;
+                    far_off[axis] = diff;
+                    pending[len] = (far, far_off, far_rd);
+                    len += 1;
+                }
+                node = near;
+                continue;
             }
-            return;
+            let d2 = self.leaf_distances(nd, q);
+            let ids = &self.leaf_ids[nd.start as usize..nd.start as usize + LEAF_SIZE];
+            found.visit_leaf(&d2, ids);
+            // Resume at the latest pending far child that is still within the bound.
+            loop {
+                if len == 0 {
+                    return;
+                }
+                len -= 1;
+                let (far, far_off, far_rd) = pending[len];
+                if far_rd <= found.bound() * PRUNE_SLACK {
+                    (node, off, rd) = (far, far_off, far_rd);
+                    break;
+                }
+            }
         }
-        let axis = nd.axis as usize;
-        let diff = q[axis] - nd.split;
-        let (near, far) = if diff < 0.0 {
-            (node + 1, nd.right)
-        } else {
-            (nd.right, node + 1)
-        };
-        self.search(near, q, off, rd, found);
-        let far_rd = rd - off[axis] * off[axis] + diff * diff;
-        if far_rd <= found.bound() * PRUNE_SLACK {
-            let mut far_off = off;
-            far_off[axis] = diff;
-            self.search(far, q, far_off, far_rd, found);
+    }
+}
+
+/// Most far children a [`PointTree::search`] keeps pending (see there).
+const MAX_PENDING: usize = 32;
+
+/// What a [`PointTree::search`] collects from the leaves it visits.
+trait Collector {
+    /// Squared distance beyond which no point can be collected any more (prunes cells); never
+    /// grows during a search.
+    fn bound(&self) -> f32;
+
+    /// Offers the points of one leaf: squared distances `d2` (NaN for padding) and input
+    /// indices `ids` of its slots.
+    fn visit_leaf(&mut self, d2: &[f32; LEAF_SIZE], ids: &[u32]);
+}
+
+/// The single nearest point found so far, `(d2, id)` (ties: smaller index).
+struct Nearest(f32, u32);
+
+impl Collector for Nearest {
+    #[inline]
+    fn bound(&self) -> f32 {
+        self.0
+    }
+
+    #[inline]
+    fn visit_leaf(&mut self, d2: &[f32; LEAF_SIZE], ids: &[u32]) {
+        let mut mask = within(d2, self.0);
+        while mask != 0 {
+            let i = mask.trailing_zeros() as usize;
+            mask &= mask - 1;
+            let id = ids[i];
+            if d2[i] < self.0 || (d2[i] == self.0 && id < self.1) {
+                (self.0, self.1) = (d2[i], id);
+            }
+        }
+    }
+}
+
+impl Collector for Neighbours {
+    /// The squared distance a point must not exceed to enter: the limit until `k` are found,
+    /// then the current `k`-th distance (never above the limit).
+    #[inline]
+    fn bound(&self) -> f32 {
+        self.bound
+    }
+
+    #[inline]
+    fn visit_leaf(&mut self, d2: &[f32; LEAF_SIZE], ids: &[u32]) {
+        let mut mask = within(d2, self.bound);
+        while mask != 0 {
+            let i = mask.trailing_zeros() as usize;
+            mask &= mask - 1;
+            self.offer(d2[i], ids[i]);
         }
     }
 }
@@ -530,6 +573,27 @@ mod tests {
                 .fold(0u32, |m, i| m | 1 << i);
             assert_eq!(within(&d2, 0.5), plain);
         }
+    }
+
+    /// Inner levels on the deepest root-to-leaf path of `tree`'s subtree at `node`.
+    fn inner_depth(tree: &PointTree, node: u32) -> usize {
+        let nd = tree.nodes[node as usize];
+        if nd.axis == LEAF {
+            return 0;
+        }
+        1 + inner_depth(tree, node + 1).max(inner_depth(tree, nd.right))
+    }
+
+    #[test]
+    fn searches_keep_fewer_far_children_pending_than_the_stack_holds() {
+        // One pending far child per inner level at most; median splits keep the depth near
+        // log2(n / LEAF_SIZE), far below the stack for the sizes the losses use.
+        let mut rng = ChaCha8Rng::seed_from_u64(5);
+        let points = stress_points(&mut rng, 200_000);
+        let tree = PointTree::new(&points);
+        let depth = inner_depth(&tree, 0);
+        assert!(depth <= 15, "depth {depth}");
+        assert!(depth < MAX_PENDING);
     }
 
     #[test]
