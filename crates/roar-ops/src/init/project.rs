@@ -549,7 +549,7 @@ impl Halves {
     fn of(grid: &Grid, corners: &[[usize; 3]]) -> Halves {
         let axis = (0..3).max_by_key(|&a| grid.dims[a]).unwrap_or(0);
         let mid = grid.dims[axis] / 2;
-        let part = |c: &[usize; 3]| {
+        let part = |c: &[usize; 3]| -> u8 {
             if c[axis] + 2 < mid {
                 0
             } else if c[axis] > mid + 2 {
@@ -558,13 +558,23 @@ impl Halves {
                 1
             }
         };
-        let mut order: Vec<u32> = (0..corners.len() as u32).collect();
-        order.sort_by_key(|&v| part(&corners[v as usize]));
-        let count = |p| corners.iter().filter(|c| part(c) == p).count();
+        // A stable partition into the three parts (each in vertex order), by counting: the
+        // same order as a stable sort by part, in one pass over the vertices and no sort.
+        let parts: Vec<u8> = corners.iter().map(part).collect();
+        let mut sizes = [0usize; 3];
+        for &p in &parts {
+            sizes[p as usize] += 1;
+        }
+        let mut next = [0, sizes[0], sizes[0] + sizes[1]];
+        let mut order = vec![0u32; corners.len()];
+        for (v, &p) in parts.iter().enumerate() {
+            order[next[p as usize]] = v as u32;
+            next[p as usize] += 1;
+        }
         Halves {
             order,
-            low: count(0),
-            band: count(1),
+            low: sizes[0],
+            band: sizes[1],
         }
     }
 
@@ -669,6 +679,38 @@ mod tests {
     use rand::{Rng, SeedableRng};
     use rand_chacha::ChaCha8Rng;
     use roar_mesh::spatial::TriangleBvh;
+
+    /// The counting partition of [`Halves::of`] gives the order of a stable sort by part.
+    #[test]
+    fn halves_order_is_a_stable_sort_by_part() {
+        let grid = Grid {
+            dims: [12, 30, 9],
+            origin: DVec3::ZERO,
+            voxel_size: 1.0,
+        };
+        let mut rng = ChaCha8Rng::seed_from_u64(3);
+        let corners: Vec<[usize; 3]> = (0..500)
+            .map(|_| {
+                [
+                    rng.random_range(0..=12),
+                    rng.random_range(0..=30),
+                    rng.random_range(0..=9),
+                ]
+            })
+            .collect();
+        let halves = Halves::of(&grid, &corners);
+        let part = |c: &[usize; 3]| match c[1] {
+            y if y + 2 < 15 => 0,
+            y if y > 17 => 2,
+            _ => 1,
+        };
+        let mut expected: Vec<u32> = (0..corners.len() as u32).collect();
+        expected.sort_by_key(|&v| part(&corners[v as usize]));
+        assert_eq!(halves.order, expected);
+        let count = |p| corners.iter().filter(|c| part(c) == p).count();
+        assert_eq!((halves.low, halves.band), (count(0), count(1)));
+        assert!(count(0) > 0 && count(1) > 0 && count(2) > 0);
+    }
 
     /// Oracle: over random walks of the query points (small steps, so most refreshes take the
     /// certified shortcut, and a few large jumps), every refresh gives exactly the points of

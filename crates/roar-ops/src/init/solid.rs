@@ -224,23 +224,185 @@ fn repair(
         if fill.is_empty() {
             return Some(counts);
         }
-        let mut blocked: Vec<u8> = state.iter().map(|&s| u8::from(s == SOLID)).collect();
-        for idx in fill {
-            if !grid.on_border(grid.coords(idx)) && blocked[idx] == 0 {
-                blocked[idx] = 1;
-                counts.voxels_added += 1;
-            }
+        fill.retain(|&idx| state[idx] == EXTERIOR && !grid.on_border(grid.coords(idx)));
+        fill.sort_unstable();
+        fill.dedup();
+        counts.voxels_added += fill.len();
+        let changed = if incremental {
+            fill_and_reflood(grid, state, &fill)
+        } else {
+            fill_and_flood_all(grid, state, &fill)
+        };
+        for dirty in [&mut edge_dirty, &mut corner_dirty].into_iter().flatten() {
+            dirty.extend_from_slice(&changed);
         }
-        let flooded = flood_exterior(grid, &blocked);
-        let changed = (0..grid.len()).filter(|&i| flooded[i] != state[i]);
-        for i in changed {
-            for dirty in [&mut edge_dirty, &mut corner_dirty].into_iter().flatten() {
-                dirty.push(i);
-            }
-        }
-        *state = flooded;
     }
     None
+}
+
+/// Turns the exterior voxels `fill` solid and floods the exterior again from the border over the
+/// whole grid: every exterior voxel the fill cut off from the border turns solid too. Returns
+/// the voxels that changed, in index order.
+fn fill_and_flood_all(grid: &Grid, state: &mut Vec<u8>, fill: &[usize]) -> Vec<usize> {
+    let mut blocked: Vec<u8> = state.iter().map(|&s| u8::from(s == SOLID)).collect();
+    for &idx in fill {
+        blocked[idx] = 1;
+    }
+    let flooded = flood_exterior(grid, &blocked);
+    let changed = (0..grid.len())
+        .filter(|&i| flooded[i] != state[i])
+        .collect();
+    *state = flooded;
+    changed
+}
+
+/// Margins (in voxels) of the boxes around a cluster of filled voxels in which
+/// [`fill_and_reflood`] looks for paths between the cluster's exterior neighbours, tried in
+/// turn.
+const REFLOOD_MARGINS: [usize; 2] = [2, 8];
+
+/// Largest box (in voxels) [`fill_and_reflood`] floods around one cluster before it gives up
+/// and floods the whole grid.
+const MAX_REFLOOD_BOX: usize = 1 << 16;
+
+/// The same as [`fill_and_flood_all`] (same `state`, same voxels returned), for a `state` whose
+/// exterior is exactly the set of voxels the border reaches through exterior voxels (true of
+/// every flood's result, and of the closing's regrowth, which only adds voxels next to the
+/// exterior), and `fill` sorted, distinct, exterior and off the border.
+///
+/// Why a local test suffices: split `fill` into face-connected clusters. If, for every cluster,
+/// its exterior face neighbours are joined to each other by exterior paths inside a box around
+/// the cluster, then every exterior path to the border that crossed a filled voxel can be
+/// rerouted around its cluster (it enters and leaves through two of those neighbours), so every
+/// remaining exterior voxel still reaches the border and only `fill` changes. When a cluster
+/// fails the test (a pocket may have been closed off), the whole grid is flooded. A full flood
+/// reads the whole grid, where the manifold repair's fills are a few thousand voxels, most of
+/// them in clusters of one to a few voxels.
+fn fill_and_reflood(grid: &Grid, state: &mut Vec<u8>, fill: &[usize]) -> Vec<usize> {
+    for &idx in fill {
+        state[idx] = SOLID;
+    }
+    let mut clustered = vec![false; fill.len()];
+    let mut cluster: Vec<usize> = Vec::new();
+    let mut scratch = LocalFlood::default();
+    for start in 0..fill.len() {
+        if clustered[start] {
+            continue;
+        }
+        // The face-connected cluster of `fill[start]`.
+        clustered[start] = true;
+        cluster.clear();
+        cluster.push(fill[start]);
+        let mut next = 0;
+        while next < cluster.len() {
+            let idx = cluster[next];
+            next += 1;
+            for n in face_neighbours(grid, idx).into_iter().flatten() {
+                if let Ok(k) = fill.binary_search(&n)
+                    && !clustered[k]
+                {
+                    clustered[k] = true;
+                    cluster.push(n);
+                }
+            }
+        }
+        let exits: Vec<usize> = cluster
+            .iter()
+            .flat_map(|&idx| face_neighbours(grid, idx).into_iter().flatten())
+            .filter(|&n| state[n] == EXTERIOR)
+            .collect();
+        let joined = REFLOOD_MARGINS
+            .iter()
+            .any(|&margin| scratch.joins(grid, state, &cluster, &exits, margin));
+        if !joined {
+            // Undo, then take the exact path over the whole grid.
+            for &idx in fill {
+                state[idx] = EXTERIOR;
+            }
+            return fill_and_flood_all(grid, state, fill);
+        }
+    }
+    fill.to_vec()
+}
+
+/// The six face neighbours of voxel `idx` that lie in the grid.
+fn face_neighbours(grid: &Grid, idx: usize) -> [Option<usize>; 6] {
+    let c = grid.coords(idx);
+    let stride = [1, grid.dims[0], grid.dims[0] * grid.dims[1]];
+    let mut out = [None; 6];
+    for a in 0..3 {
+        if c[a] > 0 {
+            out[2 * a] = Some(idx - stride[a]);
+        }
+        if c[a] + 1 < grid.dims[a] {
+            out[2 * a + 1] = Some(idx + stride[a]);
+        }
+    }
+    out
+}
+
+/// Scratch space of the local floods of [`fill_and_reflood`].
+#[derive(Default)]
+struct LocalFlood {
+    seen: Vec<bool>,
+    stack: Vec<[usize; 3]>,
+}
+
+impl LocalFlood {
+    /// Whether every voxel of `exits` (exterior voxels) is joined to the first by a path of
+    /// face-adjacent exterior voxels inside the bounding box of `cluster` grown by `margin`
+    /// (clamped to the grid). `false` also when that box holds more than [`MAX_REFLOOD_BOX`]
+    /// voxels.
+    fn joins(
+        &mut self,
+        grid: &Grid,
+        state: &[u8],
+        cluster: &[usize],
+        exits: &[usize],
+        margin: usize,
+    ) -> bool {
+        let Some(&first) = exits.first() else {
+            return true;
+        };
+        let (mut lo, mut hi) = ([usize::MAX; 3], [0usize; 3]);
+        for &idx in cluster {
+            let c = grid.coords(idx);
+            for a in 0..3 {
+                lo[a] = lo[a].min(c[a].saturating_sub(margin));
+                hi[a] = hi[a].max((c[a] + margin).min(grid.dims[a] - 1));
+            }
+        }
+        let size = [0, 1, 2].map(|a| hi[a] - lo[a] + 1);
+        let volume = size[0] * size[1] * size[2];
+        if volume > MAX_REFLOOD_BOX {
+            return false;
+        }
+        let local =
+            |c: [usize; 3]| (c[0] - lo[0]) + size[0] * ((c[1] - lo[1]) + size[1] * (c[2] - lo[2]));
+        self.seen.clear();
+        self.seen.resize(volume, false);
+        self.stack.clear();
+        let start = grid.coords(first);
+        self.seen[local(start)] = true;
+        self.stack.push(start);
+        while let Some(c) = self.stack.pop() {
+            for a in 0..3 {
+                for up in [false, true] {
+                    if (!up && c[a] == lo[a]) || (up && c[a] == hi[a]) {
+                        continue;
+                    }
+                    let mut n = c;
+                    n[a] = if up { c[a] + 1 } else { c[a] - 1 };
+                    let slot = local(n);
+                    if !self.seen[slot] && state[grid.index(n[0], n[1], n[2])] == EXTERIOR {
+                        self.seen[slot] = true;
+                        self.stack.push(n);
+                    }
+                }
+            }
+        }
+        exits.iter().all(|&idx| self.seen[local(grid.coords(idx))])
+    }
 }
 
 /// Calls `visit(a, c)` for the edges to check, as (axis `a`, voxel `c`) with the four voxels
@@ -417,6 +579,60 @@ mod tests {
             assert_eq!(incremental, full);
             assert!(a.passes > 1, "a case that needs several passes");
         }
+    }
+
+    /// The local re-flood gives what a full flood gives, on random solids with random fills:
+    /// single voxels, clusters, and walls that close pockets off (which take the full path).
+    #[test]
+    fn local_reflood_equals_a_full_flood() {
+        let g = Grid {
+            dims: [16, 13, 11],
+            origin: DVec3::ZERO,
+            voxel_size: 1.0,
+        };
+        let mut seed = 0x2545_F491_4F6C_DD1Du64;
+        let mut next = move || {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            seed
+        };
+        let (mut local, mut full) = (0, 0);
+        for case in 0..200 {
+            let density = 2 + case % 5;
+            let blocked: Vec<u8> = (0..g.len())
+                .map(|idx| u8::from(!g.on_border(g.coords(idx)) && next() % 10 < density as u64))
+                .collect();
+            let start = flood_exterior(&g, &blocked);
+            let mut fill: Vec<usize> = (0..g.len())
+                .filter(|&idx| start[idx] == EXTERIOR && !g.on_border(g.coords(idx)))
+                .filter(|_| next() % 100 < 1 + case as u64 % 13)
+                .collect();
+            // Grow some fills into clusters.
+            let grown: Vec<usize> = fill
+                .iter()
+                .flat_map(|&idx| face_neighbours(&g, idx).into_iter().flatten())
+                .filter(|&n| start[n] == EXTERIOR && !g.on_border(g.coords(n)))
+                .filter(|_| next() % 3 == 0)
+                .collect();
+            fill.extend(grown);
+            fill.sort_unstable();
+            fill.dedup();
+            let (mut a, mut b) = (start.clone(), start.clone());
+            let changed_a = fill_and_reflood(&g, &mut a, &fill);
+            let changed_b = fill_and_flood_all(&g, &mut b, &fill);
+            assert_eq!(a, b, "case {case}");
+            assert_eq!(changed_a, changed_b, "case {case}");
+            if changed_b.len() == fill.len() {
+                local += 1;
+            } else {
+                full += 1;
+            }
+        }
+        assert!(
+            local > 20 && full > 20,
+            "both paths: {local} local, {full} pockets"
+        );
     }
 
     #[test]

@@ -192,6 +192,41 @@ impl FaceGrid {
         self.slots[f as usize] = Slot::Cells { lo, hi };
     }
 
+    /// The same as [`Self::insert`] (afterwards every query reports the same faces with the same
+    /// boxes and corners), but when `f` is listed and its new box covers the same cells as its
+    /// old one, its entries are overwritten where they are: one scan of each of its buckets,
+    /// where a remove and an insert scan each bucket and then push to it again. After a collapse
+    /// most faces around the kept vertex move by less than a cell. (Only the order of entries in
+    /// a bucket can differ from [`Self::insert`], which no query answer depends on.)
+    pub(crate) fn update(&mut self, f: u32, corners: [u32; 3], b: &Aabb) {
+        let bx = Box32::around(b);
+        let (lo, hi) = self.range(&bx);
+        let same_cells = matches!(
+            self.slots[f as usize],
+            Slot::Cells { lo: old_lo, hi: old_hi } if old_lo == lo && old_hi == hi
+        );
+        if !same_cells || !bx.is_finite() {
+            self.insert(f, corners, b);
+            return;
+        }
+        let entry = Entry {
+            face: f,
+            corners,
+            bx,
+            first: lo,
+        };
+        for x in lo[0]..=hi[0] {
+            for y in lo[1]..=hi[1] {
+                for z in lo[2]..=hi[2] {
+                    let k = self.bucket([x, y, z]);
+                    if let Some(e) = self.buckets[k].iter_mut().find(|e| e.face == f) {
+                        *e = entry;
+                    }
+                }
+            }
+        }
+    }
+
     /// Removes face `f` (no-op if absent).
     pub(crate) fn remove(&mut self, f: u32) {
         match std::mem::replace(&mut self.slots[f as usize], Slot::Absent) {
@@ -305,6 +340,63 @@ mod tests {
         g.remove(1);
         g.remove(3);
         assert_eq!(found(&g, &boxed(0.0, 1.5)), vec![0]);
+    }
+
+    /// Every query answer after `update` equals the answer after `insert`, for moves that keep
+    /// a face's cells, move it to other cells, make it oversized and bring it back.
+    #[test]
+    fn update_answers_like_insert() {
+        let mut seed = 0x1234_5678_9ABC_DEF1u64;
+        let mut next = move || {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            (seed >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let random_box = |next: &mut dyn FnMut() -> f64| {
+            let lo = DVec3::new(next(), next(), next()) * 6.0 - DVec3::splat(3.0);
+            let size = if next() < 0.05 { 40.0 } else { 0.05 + next() };
+            Aabb {
+                min: lo,
+                max: lo + DVec3::new(next(), next(), next()) * size,
+            }
+        };
+        let n = 60;
+        // 64 buckets for faces of up to ~3³ cells: many cells share buckets.
+        let (mut a, mut b) = (FaceGrid::new(0.5, n, 1), FaceGrid::new(0.5, n, 1));
+        let mut boxes: Vec<Aabb> = (0..n).map(|_| random_box(&mut next)).collect();
+        for (f, bx) in boxes.iter().enumerate() {
+            a.insert(f as u32, [f as u32, 0, 0], bx);
+            b.insert(f as u32, [f as u32, 0, 0], bx);
+        }
+        let mut in_place = 0;
+        for round in 0..400u32 {
+            let f = (next() * n as f64) as usize;
+            let old = boxes[f];
+            boxes[f] = if next() < 0.7 {
+                // A small move: usually the same cells.
+                let d = DVec3::new(next(), next(), next()) * 0.02;
+                Aabb {
+                    min: old.min + d,
+                    max: old.max + d,
+                }
+            } else {
+                random_box(&mut next)
+            };
+            let same = a.range(&Box32::around(&old)) == a.range(&Box32::around(&boxes[f]));
+            in_place += usize::from(same);
+            a.update(f as u32, [f as u32, round, 1], &boxes[f]);
+            b.insert(f as u32, [f as u32, round, 1], &boxes[f]);
+            let q = random_box(&mut next);
+            let answers = |g: &FaceGrid| {
+                let mut found = Vec::new();
+                g.query(&Box32::around(&q), |f, bx, c| found.push((f, *bx, c)));
+                found.sort_by_key(|&(f, _, _)| f);
+                found
+            };
+            assert_eq!(answers(&a), answers(&b), "round {round}");
+        }
+        assert!(in_place > 100, "only {in_place} in-place updates");
     }
 
     #[test]

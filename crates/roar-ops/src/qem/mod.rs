@@ -881,7 +881,7 @@ impl<'m, F: FnMut(&Collapse)> Decimator<'m, F> {
             }
             for f in self.mesh.faces_around(b) {
                 let (corners, bx) = face_corners_and_box(self.mesh, f);
-                grid.insert(f.raw(), corners, &bx);
+                grid.update(f.raw(), corners, &bx);
             }
         }
         let start = self.mesh.halfedge_of_vertex(b);
