@@ -253,22 +253,36 @@ impl KnnPlanarProjector {
                 })
                 .collect()
         };
-        // Per chunk, scattered straight from the chunks' vectors (no concatenated copy).
-        let per_chunk: Vec<Vec<Option<DVec3>>> = if order.len() <= CHUNK {
-            vec![work(order)]
-        } else {
-            order.par_chunks(CHUNK).map(work).collect()
-        };
-        let mut result = vec![None; points.len()];
-        for (chunk, moves) in order.chunks(CHUNK).zip(per_chunk) {
-            for (&i, d) in chunk.iter().zip(moves) {
-                if let Some(slot) = result.get_mut(i as usize) {
-                    *slot = d;
-                }
+        answers_in_order(order, points.len(), CHUNK, work)
+    }
+}
+
+/// Runs `work` over `order` (indices below `len`, each at most once) in chunks of `chunk`
+/// indices, in parallel when there is more than one chunk, and puts each answer at its index
+/// of a vector of `len` (`None` at indices `order` does not list; indices out of range are
+/// ignored). `work` answers a chunk's indices in the chunk's order; searches that carry a
+/// bound from one answer to the next get a tight bound when `order` is spatially coherent.
+/// The answers are scattered straight from the chunks' vectors, without a concatenated copy.
+pub(crate) fn answers_in_order<T: Copy + Send>(
+    order: &[u32],
+    len: usize,
+    chunk: usize,
+    work: impl Fn(&[u32]) -> Vec<Option<T>> + Sync,
+) -> Vec<Option<T>> {
+    let per_chunk: Vec<Vec<Option<T>>> = if order.len() <= chunk {
+        vec![work(order)]
+    } else {
+        order.par_chunks(chunk).map(&work).collect()
+    };
+    let mut result = vec![None; len];
+    for (indices, answers) in order.chunks(chunk).zip(per_chunk) {
+        for (&i, a) in indices.iter().zip(answers) {
+            if let Some(slot) = result.get_mut(i as usize) {
+                *slot = a;
             }
         }
-        result
     }
+    result
 }
 
 impl Projector for KnnPlanarProjector {

@@ -10,13 +10,12 @@
 use glam::DVec3;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-use rayon::prelude::*;
 use roar_mesh::spatial::regular_sampling::{
     continuous_grid_size, face_grid, grid_point_count, round_grid_size,
 };
 use roar_mesh::spatial::{RegularSamples, RegularSamplingOptions};
 
-use crate::knn_projector::{KnnOptions, KnnPlanarProjector};
+use crate::knn_projector::{KnnOptions, KnnPlanarProjector, answers_in_order};
 use crate::point_tree::PointTree;
 use crate::{Loss, LossError};
 
@@ -144,9 +143,19 @@ impl PlanarLoss {
     /// The moves `d_i` of the given samples (s2t, combined with t2s when enabled): `None` when
     /// neither term gives a valid move. Deterministic.
     pub fn moves(&self, points: &[DVec3], normals: &[DVec3]) -> Vec<Option<DVec3>> {
+        self.moves_and_t2s_count(points, normals).0
+    }
+
+    /// [`PlanarLoss::moves`], and how many of them came from the t2s term.
+    fn moves_and_t2s_count(
+        &self,
+        points: &[DVec3],
+        normals: &[DVec3],
+    ) -> (Vec<Option<DVec3>>, usize) {
         if !self.options.t2s {
-            return self.projector.displacements(points, normals);
+            return (self.projector.displacements(points, normals), 0);
         }
+        // The t2s tree over the samples also gives s2t a coherent search order.
         let tree = SampleTree::new(points);
         let s2t = self
             .projector
@@ -160,7 +169,12 @@ impl PlanarLoss {
             self.options.t2s_normal_dot,
             self.projector.spatial_order(),
         );
-        combine_moves(&s2t, &t2s)
+        let from_t2s = s2t
+            .iter()
+            .zip(&t2s)
+            .filter(|(a, b)| len2(**b) > len2(**a))
+            .count();
+        (combine_moves(&s2t, &t2s), from_t2s)
     }
 
     /// The regular samples of this evaluation under the cap (spec §3.3, normals blended from
@@ -197,30 +211,7 @@ impl Loss for PlanarLoss {
             generated,
         } = self.draw_samples(positions, triangles);
 
-        let (moves, from_t2s) = if self.options.t2s {
-            // The t2s tree over the samples also gives s2t a coherent search order.
-            let tree = SampleTree::new(&points);
-            let s2t =
-                self.projector
-                    .displacements_in_order(&points, &normals, &tree.spatial_order());
-            let t2s = t2s_moves_in_order(
-                &points,
-                &normals,
-                &tree,
-                self.projector.points(),
-                self.projector.normals(),
-                self.options.t2s_normal_dot,
-                self.projector.spatial_order(),
-            );
-            let from_t2s = s2t
-                .iter()
-                .zip(&t2s)
-                .filter(|(a, b)| len2(**b) > len2(**a))
-                .count();
-            (combine_moves(&s2t, &t2s), from_t2s)
-        } else {
-            (self.projector.displacements(&points, &normals), 0)
-        };
+        let (moves, from_t2s) = self.moves_and_t2s_count(&points, &normals);
         let targets: Vec<Option<DVec3>> = moves
             .iter()
             .zip(&points)
@@ -357,20 +348,7 @@ fn t2s_moves_in_order(
             })
             .collect()
     };
-    // Per chunk, scattered straight from the chunks' vectors (no concatenated copy).
-    let per_chunk: Vec<Vec<Option<(u32, f64)>>> = if order.len() <= CHUNK {
-        vec![assign_chunk(order)]
-    } else {
-        order.par_chunks(CHUNK).map(assign_chunk).collect()
-    };
-    let mut assigned: Vec<Option<(u32, f64)>> = vec![None; target_points.len()];
-    for (chunk, answers) in order.chunks(CHUNK).zip(per_chunk) {
-        for (&j, a) in chunk.iter().zip(answers) {
-            if let Some(slot) = assigned.get_mut(j as usize) {
-                *slot = a;
-            }
-        }
-    }
+    let assigned = answers_in_order(order, target_points.len(), CHUNK, assign_chunk);
     let mut farthest: Vec<Option<(usize, f64)>> = vec![None; samples.len()];
     for (j, a) in assigned.iter().enumerate() {
         let Some((i, d2)) = *a else { continue };
