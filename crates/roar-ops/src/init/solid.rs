@@ -582,7 +582,8 @@ mod tests {
     }
 
     /// The local re-flood gives what a full flood gives, on random solids with random fills:
-    /// single voxels, clusters, and walls that close pockets off (which take the full path).
+    /// single voxels, clusters, and walls that close pockets off (where the local test must
+    /// fail and the full flood decide).
     #[test]
     fn local_reflood_equals_a_full_flood() {
         let g = Grid {
@@ -597,7 +598,7 @@ mod tests {
             seed ^= seed << 17;
             seed
         };
-        let (mut local, mut full) = (0, 0);
+        let (mut fill_only, mut pockets) = (0, 0);
         for case in 0..200 {
             let density = 2 + case % 5;
             let blocked: Vec<u8> = (0..g.len())
@@ -624,14 +625,16 @@ mod tests {
             assert_eq!(a, b, "case {case}");
             assert_eq!(changed_a, changed_b, "case {case}");
             if changed_b.len() == fill.len() {
-                local += 1;
+                fill_only += 1;
             } else {
-                full += 1;
+                pockets += 1;
             }
         }
+        // Both kinds of case occur: fills that change nothing else, and fills that close a
+        // pocket off.
         assert!(
-            local > 20 && full > 20,
-            "both paths: {local} local, {full} pockets"
+            fill_only > 20 && pockets > 20,
+            "{fill_only} fills alone, {pockets} with pockets"
         );
     }
 
