@@ -1,20 +1,21 @@
 //! End-to-end reconstructions (release mode, run by `.ci/run` with `--ignored`): the shipped
-//! example and three small wild meshes at 1000 faces. Each output must be a closed, oriented
+//! example and two small wild meshes at 1000 faces. Each output must be a closed, oriented
 //! 2-manifold with exactly the budget, no self-intersecting faces, no more components than the
 //! init, and a Chamfer distance below that of the init decimated to the same budget (what the
 //! optimization adds): at least 10 % below on trimesh-rabbit and luke-f-16, and not above it on
-//! the two inputs where the init + QEM is already about as close as roar gets:
-//!
-//! - the example, boxes and a zero-thickness sheet: since the QEM has planar quadrics, the
-//!   box-shaped init decimated to 1000 faces is about as close as roar gets (this test's
-//!   Chamfer/diag: 2.42e-3 against roar's 2.38e-3; it was 4.28e-3 before; the one-sided
-//!   distances agree within 2 %: what is left is the sheet's thickness and the soup's interior
-//!   faces, which no closed surface comes nearer to);
-//! - manifoldplus-chair, whose slat gaps the init's one-voxel closing fills (the genus roar
-//!   keeps): 2.91e-3 against roar's 2.68e-3 (−8.1 %; it was 3.98e-3 before).
+//! the example, where the init + QEM is already about as close as roar gets: since the QEM has
+//! planar quadrics, the box-shaped init decimated to 1000 faces is about as close as roar gets
+//! (this test's Chamfer/diag: 2.42e-3 against roar's 2.38e-3; it was 4.28e-3 before; the
+//! one-sided distances agree within 2 %: what is left is the sheet's thickness and the soup's
+//! interior faces, which no closed surface comes nearer to).
 //!
 //! Measured with the sixth session's code (in release, at load 5): trimesh-rabbit 3.31e-3 →
-//! 2.39e-3 (−27.8 %), luke-f-16 1.89e-3 → 1.51e-3 (−19.9 %); 1124 s for the four inputs.
+//! 2.39e-3 (−27.8 %), luke-f-16 1.89e-3 → 1.51e-3 (−19.9 %).
+//!
+//! The inputs run side by side, one thread each: much of a run (the blocks, the step limiter,
+//! the QEM) is sequential, so the second core would otherwise idle through it. (This test once
+//! also ran manifoldplus-chair, whose bar was "not above init + QEM"; the CI time it cost is
+//! better spent elsewhere, and the evaluation script covers it.)
 
 use std::path::PathBuf;
 
@@ -25,7 +26,7 @@ use roar_mesh::spatial::self_intersecting_faces;
 
 const FACES: usize = 1000;
 
-/// The inputs with the largest ratio of roar's Chamfer to the init + QEM's that each must meet.
+/// The inputs, each with the largest ratio of roar's Chamfer to the init + QEM's it must meet.
 fn inputs() -> Vec<(PathBuf, f64)> {
     let mut files = vec![(
         PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../examples/chair_soup.obj"),
@@ -40,7 +41,6 @@ fn inputs() -> Vec<(PathBuf, f64)> {
                 wild.display()
             );
             files.push((wild.join("trimesh-rabbit.obj"), 0.9));
-            files.push((wild.join("manifoldplus-chair.off"), 1.0));
             // Thin wings and fins: the Face Collapse block once ate them from their rims and
             // left this mesh 2.5× worse than its own init + QEM.
             files.push((wild.join("luke-f-16.obj"), 0.9));
@@ -73,30 +73,59 @@ fn chamfer_over_diag(
     .chamfer_l2_over_diag
 }
 
+/// What one input gave: roar's output and the init + QEM baseline, both at `FACES`.
+struct Run {
+    out: roar_cli::pipeline::Output,
+    baseline: roar_cli::pipeline::Output,
+    seconds: f64,
+}
+
+fn reconstruct(name: &str, soup: &roar_io::TriangleSoup) -> Run {
+    let config = ReconstructConfig {
+        faces: FACES,
+        ..ReconstructConfig::default()
+    };
+    let baseline_config = ReconstructConfig {
+        iterations: 0,
+        ..config.clone()
+    };
+    let baseline = Reconstruction::new(baseline_config)
+        .run(&soup.positions, &soup.triangles, &mut |_| {})
+        .unwrap_or_else(|e| panic!("{name}, init + QEM: {e}"));
+    let started = std::time::Instant::now();
+    let out = Reconstruction::new(config)
+        .run(&soup.positions, &soup.triangles, &mut |_| {})
+        .unwrap_or_else(|e| panic!("{name}: {e}"));
+    Run {
+        out,
+        baseline,
+        seconds: started.elapsed().as_secs_f64(),
+    }
+}
+
 #[test]
 #[ignore = "minutes in release; run by .ci/run"]
 fn reconstruction_beats_init_plus_qem_and_keeps_every_promise() {
-    for (path, wanted) in inputs() {
-        let soup = roar_io::read_mesh(&path).unwrap();
-        let config = ReconstructConfig {
-            faces: FACES,
-            ..ReconstructConfig::default()
-        };
+    let inputs: Vec<(String, roar_io::TriangleSoup, f64)> = inputs()
+        .into_iter()
+        .map(|(path, wanted)| {
+            let name = path.file_name().unwrap().to_string_lossy().into_owned();
+            (name, roar_io::read_mesh(&path).unwrap(), wanted)
+        })
+        .collect();
+    let runs: Vec<Run> = std::thread::scope(|scope| {
+        let handles: Vec<_> = inputs
+            .iter()
+            .map(|(name, soup, _)| scope.spawn(move || reconstruct(name, soup)))
+            .collect();
+        handles
+            .into_iter()
+            .map(|h| h.join().unwrap_or_else(|e| std::panic::resume_unwind(e)))
+            .collect()
+    });
 
-        let baseline_config = ReconstructConfig {
-            iterations: 0,
-            ..config.clone()
-        };
-        let baseline = Reconstruction::new(baseline_config)
-            .run(&soup.positions, &soup.triangles, &mut |_| {})
-            .unwrap();
-        let started = std::time::Instant::now();
-        let out = Reconstruction::new(config)
-            .run(&soup.positions, &soup.triangles, &mut |_| {})
-            .unwrap_or_else(|e| panic!("{}: {e}", path.display()));
-        let seconds = started.elapsed().as_secs_f64();
-
-        let name = path.file_name().unwrap().to_string_lossy().into_owned();
+    for ((name, soup, wanted), run) in inputs.iter().zip(runs) {
+        let (out, baseline) = (&run.out, &run.baseline);
         assert_eq!(out.triangles.len(), FACES, "{name}: exact budget");
         let mesh = Mesh::from_triangles(out.positions.clone(), &out.triangles)
             .unwrap_or_else(|e| panic!("{name}: not a closed manifold: {e}"));
@@ -112,11 +141,12 @@ fn reconstruction_beats_init_plus_qem_and_keeps_every_promise() {
             .count();
         assert_eq!(crossing, 0, "{name}: self-intersecting faces");
 
-        let ours = chamfer_over_diag(&out.positions, &out.triangles, &soup);
-        let init = chamfer_over_diag(&baseline.positions, &baseline.triangles, &soup);
+        let ours = chamfer_over_diag(&out.positions, &out.triangles, soup);
+        let init = chamfer_over_diag(&baseline.positions, &baseline.triangles, soup);
         eprintln!(
-            "{name}: chamfer/diag {ours:.5} vs init+QEM {init:.5} ({:+.1} %), {seconds:.1} s",
-            100.0 * (ours / init - 1.0)
+            "{name}: chamfer/diag {ours:.5} vs init+QEM {init:.5} ({:+.1} %), {:.1} s",
+            100.0 * (ours / init - 1.0),
+            run.seconds
         );
         assert!(
             ours <= wanted * init,
