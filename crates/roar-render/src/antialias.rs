@@ -179,6 +179,7 @@ pub fn antialias_items(
             }
         });
     }
+    let horizontal = items.len();
     for_each_differing(ids, &ids[w.min(ids.len())..], |p| {
         if !smooth(ids[p], ids[p + w])
             && let Some(item) = ctx.pair(p, p + w, false)
@@ -186,8 +187,41 @@ pub fn antialias_items(
             items.push(item);
         }
     });
-    items.sort_by_key(|it| it.target);
-    items
+    sorted_by_target(&items, horizontal)
+}
+
+/// The items stably sorted by target pixel, when `items[..horizontal]` come from horizontal
+/// pairs and the rest from vertical pairs, each in pixel order.
+///
+/// A horizontal pair `(p, p + 1)` targets `p` or `p + 1`, so the horizontal targets never
+/// decrease; a vertical pair `(p, p + w)` targets `p` (up) or `p + w` (down), so the targets of
+/// each kind never decrease either. Merging the three sorted runs, ties taken horizontal first,
+/// then down (its pair starts `w` pixels earlier), then up, is the stable sort's order, in one
+/// pass instead of a sort.
+fn sorted_by_target(items: &[AaItem], horizontal: usize) -> Vec<AaItem> {
+    let (across, vertical) = items.split_at(horizontal);
+    type Keep = fn(&&AaItem) -> bool;
+    let kinds: [(&[AaItem], Keep); 3] = [
+        (across, |_| true),
+        (vertical, |it| it.target > it.source),
+        (vertical, |it| it.target < it.source),
+    ];
+    let mut runs = kinds.map(|(list, keep)| list.iter().filter(keep).peekable());
+    let mut sorted = Vec::with_capacity(items.len());
+    loop {
+        let mut best: Option<(usize, u32)> = None;
+        for (run, iter) in runs.iter_mut().enumerate() {
+            if let Some(it) = iter.peek()
+                && best.is_none_or(|(_, target)| it.target < target)
+            {
+                best = Some((run, it.target));
+            }
+        }
+        let Some((run, _)) = best else {
+            return sorted;
+        };
+        sorted.extend(runs[run].next().copied());
+    }
 }
 
 /// Calls `visit(i)` for every `i < min(a.len(), b.len())` with `a[i] != b[i]`, in increasing
@@ -331,6 +365,54 @@ impl PairContext<'_> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn merged_items_are_the_stable_sort_by_target() {
+        // Items of random pairs in scan order (horizontal row by row, then vertical), each
+        // targeting either pixel; `face` records the scan position to tell ties apart.
+        let mut state = 0x853c_49e6_748f_ea9bu64;
+        let mut next = |n: u32| {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 33) as u32 % n
+        };
+        for case in 0..200 {
+            let (w, h) = (1 + next(9), 1 + next(9));
+            let mut items = Vec::new();
+            let item = |p: u32, q: u32, items: &mut Vec<AaItem>, pick: u32| {
+                let (target, source) = if pick == 0 { (p, q) } else { (q, p) };
+                items.push(AaItem {
+                    target,
+                    source,
+                    front_is_target: pick == 0,
+                    face: items.len() as u32,
+                    edge: [0, 1],
+                    t: 0.25,
+                    alpha: 0.25,
+                    dalpha_dt: -1.0,
+                });
+            };
+            for p in 0..w * h {
+                if p % w + 1 < w && next(3) == 0 {
+                    item(p, p + 1, &mut items, next(2));
+                }
+            }
+            let horizontal = items.len();
+            for p in 0..w * h.saturating_sub(1) {
+                if next(3) == 0 {
+                    item(p, p + w, &mut items, next(2));
+                }
+            }
+            let mut expected = items.clone();
+            expected.sort_by_key(|it| it.target);
+            assert_eq!(
+                sorted_by_target(&items, horizontal),
+                expected,
+                "case {case}"
+            );
+        }
+    }
 
     #[test]
     fn differing_positions_match_a_plain_scan() {

@@ -80,18 +80,16 @@ fn project_view(
     camera: usize,
 ) -> Result<Vec<ProjectedVertex>, RenderError> {
     let m = cam.view_proj();
-    positions
-        .iter()
-        .enumerate()
-        .map(|(vertex, &p)| {
-            let v = project_with(&m, cam.width, cam.height, p);
-            if v.w < crate::camera::NEAR || !v.x.is_finite() || !v.y.is_finite() {
-                Err(RenderError::BehindNearPlane { vertex, camera })
-            } else {
-                Ok(v)
-            }
-        })
-        .collect()
+    // Filled in place: collecting the `Result`s would grow the vector a dozen times per view.
+    let mut verts = Vec::with_capacity(positions.len());
+    for (vertex, &p) in positions.iter().enumerate() {
+        let v = project_with(&m, cam.width, cam.height, p);
+        if v.w < crate::camera::NEAR || !v.x.is_finite() || !v.y.is_finite() {
+            return Err(RenderError::BehindNearPlane { vertex, camera });
+        }
+        verts.push(v);
+    }
+    Ok(verts)
 }
 
 /// The part of a view's forward pass that backward needs.
