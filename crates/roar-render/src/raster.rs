@@ -245,55 +245,17 @@ impl Canvas<'_> {
     /// as hidden.
     fn draw(&mut self, f: usize, corners: [[i64; 2]; 3], tiles: Option<&DepthTiles>) -> bool {
         let (w, h, triangles) = (self.w, self.h, self.triangles);
-        let tri = triangles[f];
-        let max_x = w as i64 - 1;
-        let max_y = h as i64 - 1;
-        let min_x = corners.iter().map(|c| c[0]).min().unwrap_or(0);
-        let max_cx = corners.iter().map(|c| c[0]).max().unwrap_or(0);
-        let min_y = corners.iter().map(|c| c[1]).min().unwrap_or(0);
-        let max_cy = corners.iter().map(|c| c[1]).max().unwrap_or(0);
-        let x0 = ceil_div(min_x - HALF, ONE).max(0);
-        let x1 = floor_div(max_cx - HALF, ONE).min(max_x);
-        let y0 = ceil_div(min_y - HALF, ONE).max(0);
-        let y1 = floor_div(max_cy - HALF, ONE).min(max_y);
-        if x0 > x1 || y0 > y1 {
+        let Some([x0, x1, y0, y1]) = pixel_box(corners, w, h) else {
             return true;
-        }
-        // Depth plane z = z0 + zx (x − x0) + zy (y − y0) in float pixel coordinates.
-        let [i0, i1, i2] = tri.map(|i| i as usize);
-        let (v0, v1, v2) = (&self.verts[i0], &self.verts[i1], &self.verts[i2]);
-        let (d1x, d1y, d1z) = (v1.x - v0.x, v1.y - v0.y, v1.z - v0.z);
-        let (d2x, d2y, d2z) = (v2.x - v0.x, v2.y - v0.y, v2.z - v0.z);
-        let det = d1x * d2y - d1y * d2x;
-        let (zx, zy) = if det != 0.0 {
-            ((d1z * d2y - d2z * d1y) / det, (d2z * d1x - d1z * d2x) / det)
-        } else {
-            (0.0, 0.0)
         };
-        let z_origin = v0.z + zx * (x0 as f64 + 0.5 - v0.x) + zy * (y0 as f64 + 0.5 - v0.y);
-        let (zx32, zy32, zo32) = (zx as f32, zy as f32, z_origin as f32);
+        let (zx32, zy32, zo32) = depth_plane(self.verts, triangles[f], x0, y0);
         if let Some(tiles) = tiles
             && let Some(z) = least_depth(zo32, zx32, zy32, x1 - x0, y1 - y0)
             && tiles.all_below(x0, x1, y0, y1, z)
         {
             return false;
         }
-        // Edge functions E(p) = cross(b − a, p − a), biased by the tie rule, at the first centre.
-        let px0 = x0 * ONE + HALF;
-        let py0 = y0 * ONE + HALF;
-        let mut row = [0i64; 3];
-        let mut step_x = [0i64; 3];
-        let mut step_y = [0i64; 3];
-        for k in 0..3 {
-            let a = corners[k];
-            let b = corners[(k + 1) % 3];
-            let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
-            let include_ties = dy > 0 || (dy == 0 && dx < 0);
-            let bias = if include_ties { 0 } else { -1 };
-            row[k] = dx * (py0 - a[1]) - dy * (px0 - a[0]) + bias;
-            step_x[k] = -dy * ONE;
-            step_y[k] = dx * ONE;
-        }
+        let (mut row, step_x, step_y) = edge_functions(corners, x0, y0);
         let fid = f as u32;
         let (depth, ids) = (&mut self.depth, &mut self.ids);
         let visit = |depth: &mut [f32], ids: &mut [u32], p: usize, z: f32| {
@@ -385,6 +347,59 @@ impl Canvas<'_> {
     }
 }
 
+/// The pixels whose centres the box of `corners` (snapped) covers, `[x0, x1, y0, y1]` inclusive
+/// and clipped to a `w`×`h` image; `None` when it holds no pixel centre.
+fn pixel_box(corners: [[i64; 2]; 3], w: usize, h: usize) -> Option<[i64; 4]> {
+    let min_x = corners.iter().map(|c| c[0]).min().unwrap_or(0);
+    let max_x = corners.iter().map(|c| c[0]).max().unwrap_or(0);
+    let min_y = corners.iter().map(|c| c[1]).min().unwrap_or(0);
+    let max_y = corners.iter().map(|c| c[1]).max().unwrap_or(0);
+    let x0 = ceil_div(min_x - HALF, ONE).max(0);
+    let x1 = floor_div(max_x - HALF, ONE).min(w as i64 - 1);
+    let y0 = ceil_div(min_y - HALF, ONE).max(0);
+    let y1 = floor_div(max_y - HALF, ONE).min(h as i64 - 1);
+    (x0 <= x1 && y0 <= y1).then_some([x0, x1, y0, y1])
+}
+
+/// The edge functions E(p) = cross(b − a, p − a) of `corners` (in the order that makes the
+/// inside positive), biased by the tie rule, at the centre of pixel `(x0, y0)`, and their steps
+/// per pixel along x and y: `(row, step_x, step_y)`.
+fn edge_functions(corners: [[i64; 2]; 3], x0: i64, y0: i64) -> ([i64; 3], [i64; 3], [i64; 3]) {
+    let px0 = x0 * ONE + HALF;
+    let py0 = y0 * ONE + HALF;
+    let mut row = [0i64; 3];
+    let mut step_x = [0i64; 3];
+    let mut step_y = [0i64; 3];
+    for k in 0..3 {
+        let a = corners[k];
+        let b = corners[(k + 1) % 3];
+        let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
+        let include_ties = dy > 0 || (dy == 0 && dx < 0);
+        let bias = if include_ties { 0 } else { -1 };
+        row[k] = dx * (py0 - a[1]) - dy * (px0 - a[0]) + bias;
+        step_x[k] = -dy * ONE;
+        step_y[k] = dx * ONE;
+    }
+    (row, step_x, step_y)
+}
+
+/// The depth plane of triangle `tri`, z = z0 + zx (x − x0) + zy (y − y0) in float pixel
+/// coordinates, as `(zx, zy, z0)` in f32 with z0 at the centre of pixel `(x0, y0)` (flat for a
+/// triangle of zero projected area).
+fn depth_plane(verts: &[ProjectedVertex], tri: [u32; 3], x0: i64, y0: i64) -> (f32, f32, f32) {
+    let [v0, v1, v2] = tri.map(|i| &verts[i as usize]);
+    let (d1x, d1y, d1z) = (v1.x - v0.x, v1.y - v0.y, v1.z - v0.z);
+    let (d2x, d2y, d2z) = (v2.x - v0.x, v2.y - v0.y, v2.z - v0.z);
+    let det = d1x * d2y - d1y * d2x;
+    let (zx, zy) = if det != 0.0 {
+        ((d1z * d2y - d2z * d1y) / det, (d2z * d1x - d1z * d2x) / det)
+    } else {
+        (0.0, 0.0)
+    };
+    let z_origin = v0.z + zx * (x0 as f64 + 0.5 - v0.x) + zy * (y0 as f64 + 0.5 - v0.y);
+    (zx as f32, zy as f32, z_origin as f32)
+}
+
 /// A lower bound of the depths the fill loops compute over a box of `0..=width` × `0..=height`
 /// pixel offsets, `(zo + zy·dy) + zx·dx` in f32 (`None` when it may not be finite). Each
 /// rounded operation is monotone in its operands, so the depth is monotone in `dx` and in
@@ -421,8 +436,6 @@ mod tests {
         let mut depth = vec![f32::INFINITY; w * h];
         // Snap once per vertex so shared edges get identical fixed-point endpoints.
         let snapped: Vec<[i64; 2]> = verts.iter().map(|v| [snap(v.x), snap(v.y)]).collect();
-        let max_x = w as i64 - 1;
-        let max_y = h as i64 - 1;
         for (f, tri) in triangles.iter().enumerate() {
             let [i0, i1, i2] = tri.map(|i| i as usize);
             let (q0, q1, q2) = (snapped[i0], snapped[i1], snapped[i2]);
@@ -432,45 +445,11 @@ mod tests {
             }
             // Orient so that inside means all three edge functions are positive.
             let corners = if area > 0 { [q0, q1, q2] } else { [q0, q2, q1] };
-            let min_x = corners.iter().map(|c| c[0]).min().unwrap_or(0);
-            let max_cx = corners.iter().map(|c| c[0]).max().unwrap_or(0);
-            let min_y = corners.iter().map(|c| c[1]).min().unwrap_or(0);
-            let max_cy = corners.iter().map(|c| c[1]).max().unwrap_or(0);
-            let x0 = ceil_div(min_x - HALF, ONE).max(0);
-            let x1 = floor_div(max_cx - HALF, ONE).min(max_x);
-            let y0 = ceil_div(min_y - HALF, ONE).max(0);
-            let y1 = floor_div(max_cy - HALF, ONE).min(max_y);
-            if x0 > x1 || y0 > y1 {
+            let Some([x0, x1, y0, y1]) = pixel_box(corners, w, h) else {
                 continue;
-            }
-            // Edge functions E(p) = cross(b − a, p − a), biased by the tie rule, at the first centre.
-            let px0 = x0 * ONE + HALF;
-            let py0 = y0 * ONE + HALF;
-            let mut row = [0i64; 3];
-            let mut step_x = [0i64; 3];
-            let mut step_y = [0i64; 3];
-            for k in 0..3 {
-                let a = corners[k];
-                let b = corners[(k + 1) % 3];
-                let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
-                let include_ties = dy > 0 || (dy == 0 && dx < 0);
-                let bias = if include_ties { 0 } else { -1 };
-                row[k] = dx * (py0 - a[1]) - dy * (px0 - a[0]) + bias;
-                step_x[k] = -dy * ONE;
-                step_y[k] = dx * ONE;
-            }
-            // Depth plane z = z0 + zx (x − x0) + zy (y − y0) in float pixel coordinates.
-            let (v0, v1, v2) = (&verts[i0], &verts[i1], &verts[i2]);
-            let (d1x, d1y, d1z) = (v1.x - v0.x, v1.y - v0.y, v1.z - v0.z);
-            let (d2x, d2y, d2z) = (v2.x - v0.x, v2.y - v0.y, v2.z - v0.z);
-            let det = d1x * d2y - d1y * d2x;
-            let (zx, zy) = if det != 0.0 {
-                ((d1z * d2y - d2z * d1y) / det, (d2z * d1x - d1z * d2x) / det)
-            } else {
-                (0.0, 0.0)
             };
-            let z_origin = v0.z + zx * (x0 as f64 + 0.5 - v0.x) + zy * (y0 as f64 + 0.5 - v0.y);
-            let (zx32, zy32, zo32) = (zx as f32, zy as f32, z_origin as f32);
+            let (mut row, step_x, step_y) = edge_functions(corners, x0, y0);
+            let (zx32, zy32, zo32) = depth_plane(verts, *tri, x0, y0);
             let fid = f as u32;
             for y in y0..=y1 {
                 let mut e = row;
