@@ -20,6 +20,16 @@ pub(crate) struct Grid {
 }
 
 impl Grid {
+    /// A grid of unit voxels with its corner at the origin (test set-ups).
+    #[cfg(test)]
+    pub fn unit(dims: [usize; 3]) -> Grid {
+        Grid {
+            dims,
+            origin: DVec3::ZERO,
+            voxel_size: 1.0,
+        }
+    }
+
     /// A grid whose longest axis holds `resolution` voxels over `[min, max]`, padded by `padding`
     /// voxels on every side.
     pub fn around(min: DVec3, max: DVec3, resolution: usize, padding: usize) -> Grid {

@@ -683,11 +683,7 @@ mod tests {
     /// The counting partition of [`Halves::of`] gives the order of a stable sort by part.
     #[test]
     fn halves_order_is_a_stable_sort_by_part() {
-        let grid = Grid {
-            dims: [12, 30, 9],
-            origin: DVec3::ZERO,
-            voxel_size: 1.0,
-        };
+        let grid = Grid::unit([12, 30, 9]);
         let mut rng = ChaCha8Rng::seed_from_u64(3);
         let corners: Vec<[usize; 3]> = (0..500)
             .map(|_| {

@@ -520,14 +520,9 @@ fn corner_octants(grid: &Grid, state: &[u8], c: [usize; 3]) -> (u8, [usize; 8]) 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use glam::DVec3;
 
     fn grid(n: usize) -> Grid {
-        Grid {
-            dims: [n, n, n],
-            origin: DVec3::ZERO,
-            voxel_size: 1.0,
-        }
+        Grid::unit([n, n, n])
     }
 
     #[test]
@@ -586,11 +581,7 @@ mod tests {
     /// fail and the full flood decide).
     #[test]
     fn local_reflood_equals_a_full_flood() {
-        let g = Grid {
-            dims: [16, 13, 11],
-            origin: DVec3::ZERO,
-            voxel_size: 1.0,
-        };
+        let g = Grid::unit([16, 13, 11]);
         let mut seed = 0x2545_F491_4F6C_DD1Du64;
         let mut next = move || {
             seed ^= seed << 13;
@@ -640,11 +631,7 @@ mod tests {
 
     #[test]
     fn scanline_fill_equals_a_voxel_by_voxel_fill() {
-        let g = Grid {
-            dims: [9, 7, 8],
-            origin: DVec3::ZERO,
-            voxel_size: 1.0,
-        };
+        let g = Grid::unit([9, 7, 8]);
         let mut seed = 99u64;
         for density in [2u64, 5, 7, 9] {
             let blocked: Vec<u8> = (0..g.len())

@@ -271,11 +271,7 @@ mod tests {
 
     #[test]
     fn dilation_equals_the_brute_force_box_on_random_sets() {
-        let grid = Grid {
-            dims: [7, 5, 6],
-            origin: DVec3::ZERO,
-            voxel_size: 1.0,
-        };
+        let grid = Grid::unit([7, 5, 6]);
         let mut state = 12345u64;
         let mut bit = || {
             state = state
@@ -307,11 +303,7 @@ mod tests {
 
     #[test]
     fn dilation_grows_a_single_voxel_into_a_3x3x3_block() {
-        let grid = Grid {
-            dims: [5, 5, 5],
-            origin: DVec3::ZERO,
-            voxel_size: 1.0,
-        };
+        let grid = Grid::unit([5, 5, 5]);
         let mut set = vec![0u8; grid.len()];
         set[grid.index(2, 2, 2)] = 1;
         let d = dilate_box(&grid, &set);
