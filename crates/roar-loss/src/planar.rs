@@ -16,7 +16,7 @@ use roar_mesh::spatial::regular_sampling::{
 use roar_mesh::spatial::{RegularSamples, RegularSamplingOptions};
 
 use crate::knn_projector::{KnnOptions, KnnPlanarProjector, answers_in_order};
-use crate::point_tree::PointTree;
+use crate::point_tree::{PointTree, SearchStack};
 use crate::{Loss, LossError};
 
 /// Target points per parallel work item of the t2s assignment.
@@ -334,6 +334,7 @@ fn t2s_moves_in_order(
     // next search (it never changes the answer).
     let assign_chunk = |chunk: &[u32]| -> Vec<Option<(u32, f64)>> {
         let mut hint = None;
+        let mut stack = SearchStack::default();
         chunk
             .iter()
             .map(|&j| {
@@ -341,7 +342,7 @@ fn t2s_moves_in_order(
                 if !t.is_finite() {
                     return None;
                 }
-                let local = tree.nearest_one(t, hint)?;
+                let local = tree.nearest_one(t, hint, &mut stack)?;
                 hint = Some(local);
                 let i = finite[local as usize];
                 Some((i as u32, samples[i].distance_squared(t)))

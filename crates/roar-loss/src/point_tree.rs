@@ -60,12 +60,19 @@ pub(crate) struct PointTree {
 /// The best neighbours of one query, sorted by (squared distance, index); a reusable buffer so
 /// queries do not allocate. The previous answer also seeds the next query's search bound
 /// (consecutive queries are usually close), which changes the work, never the answer.
+#[derive(Debug, Clone, Default)]
+pub(crate) struct Neighbours {
+    best: Best,
+    stack: SearchStack,
+}
+
+/// The `k` best neighbours found so far by a [`PointTree::nearest_n`] search.
 ///
 /// Each neighbour is kept as one `u64` key, the f32 squared distance's bits above the index:
 /// distances are never negative, so their bits order like the numbers and the keys order like
 /// the pairs (ties broken by the smaller index) with a single comparison.
 #[derive(Debug, Clone, Default)]
-pub(crate) struct Neighbours {
+struct Best {
     keys: Vec<u64>,
     k: usize,
     /// A key enters iff it is below this: the limit's (any index) until `k` are found, then the
@@ -86,11 +93,14 @@ impl Neighbours {
     /// The neighbours found by the last query: `(f32 squared distance, index)` pairs, nearest
     /// first.
     pub(crate) fn items(&self) -> impl ExactSizeIterator<Item = (f32, u32)> + '_ {
-        self.keys
+        self.best
+            .keys
             .iter()
             .map(|&key| (f32::from_bits((key >> 32) as u32), key as u32))
     }
+}
 
+impl Best {
     /// Clears the buffer for a query of `k` neighbours known to lie within squared distance
     /// `limit` (not NaN).
     fn reset(&mut self, k: usize, limit: f32) {
@@ -278,10 +288,12 @@ impl PointTree {
         &self.ids
     }
 
-    /// Fills `found` with the `k` nearest points of `query` (fewer if the tree is smaller),
-    /// sorted by (f32 squared distance, index). `k = 0` or an empty tree gives nothing.
-    /// `found`'s previous answer (any `k` distinct points of this tree) bounds the search.
-    pub(crate) fn nearest_n(&self, query: DVec3, k: usize, found: &mut Neighbours) {
+    /// Fills `neighbours` with the `k` nearest points of `query` (fewer if the tree is
+    /// smaller), sorted by (f32 squared distance, index). `k = 0` or an empty tree gives
+    /// nothing. The buffer's previous answer (any `k` distinct points of this tree) bounds the
+    /// search.
+    pub(crate) fn nearest_n(&self, query: DVec3, k: usize, neighbours: &mut Neighbours) {
+        let Neighbours { best: found, stack } = neighbours;
         let q = to_f32(query);
         let mut limit = f32::INFINITY;
         if k > 0 && found.keys.len() == k {
@@ -299,12 +311,18 @@ impl PointTree {
             return;
         }
         let start = self.start_node(&q, limit);
-        self.search(start, &q, found);
+        self.search(start, &q, found, stack);
     }
 
     /// The nearest point of `query` (ties: smaller index); `None` for an empty tree. `hint`, a
-    /// point of this tree (e.g. the previous answer), bounds the search.
-    pub(crate) fn nearest_one(&self, query: DVec3, hint: Option<u32>) -> Option<u32> {
+    /// point of this tree (e.g. the previous answer), bounds the search; `stack` is scratch
+    /// space reused across queries.
+    pub(crate) fn nearest_one(
+        &self,
+        query: DVec3,
+        hint: Option<u32>,
+        stack: &mut SearchStack,
+    ) -> Option<u32> {
         if self.nodes.is_empty() {
             return None;
         }
@@ -315,7 +333,7 @@ impl PointTree {
         // Starts at (limit, u32::MAX): the hint itself always qualifies, so `best` is filled.
         let mut best = Nearest(limit, u32::MAX);
         let start = self.start_node(&q, limit);
-        self.search(start, &q, &mut best);
+        self.search(start, &q, &mut best, stack);
         Some(best.1)
     }
 
@@ -367,10 +385,16 @@ impl PointTree {
     /// argument passing and exit cost more than the node test itself; the visiting order and
     /// every pruning decision are those of the recursion. A pending far child is pushed per
     /// inner level of the descent, and median splits halve the points per level, so a tree
-    /// over fewer than 2³² points never holds more than [`MAX_PENDING`] of them.
-    fn search<C: Collector>(&self, start: u32, q: &[f32; 3], found: &mut C) {
-        // (node, per-axis cell offsets, squared cell distance)
-        let mut pending = [(0u32, [0.0f32; 3], 0.0f32); MAX_PENDING];
+    /// over fewer than 2³² points never holds more than [`MAX_PENDING`] of them. The stack is
+    /// the caller's ([`SearchStack`]): the search reads only the slots it wrote.
+    fn search<C: Collector>(
+        &self,
+        start: u32,
+        q: &[f32; 3],
+        found: &mut C,
+        stack: &mut SearchStack,
+    ) {
+        let pending = &mut stack.0;
         let mut len = 0;
         let (mut node, mut off, mut rd) = (start, [0.0f32; 3], 0.0f32);
         loop {
@@ -417,6 +441,16 @@ impl PointTree {
 /// Most far children a [`PointTree::search`] keeps pending (see there).
 const MAX_PENDING: usize = 32;
 
+/// A far child waiting in a [`PointTree::search`]: (node, per-axis cell offsets, squared cell
+/// distance).
+type Pending = (u32, [f32; 3], f32);
+
+/// The pending far children of a [`PointTree::search`], kept by the caller across queries.
+/// Only the slots a search writes are read back by that search, so the array is filled once
+/// when created instead of once per query (which cost more than a short search's pushes).
+#[derive(Debug, Clone, Default)]
+pub(crate) struct SearchStack([Pending; MAX_PENDING]);
+
 /// What a [`PointTree::search`] collects from the leaves it visits.
 trait Collector {
     /// Squared distance beyond which no point can be collected any more (prunes cells); never
@@ -451,7 +485,7 @@ impl Collector for Nearest {
     }
 }
 
-impl Collector for Neighbours {
+impl Collector for Best {
     /// The squared distance a point must not exceed to enter: the limit until `k` are found,
     /// then the current `k`-th distance (never above the limit).
     #[inline]
@@ -512,6 +546,7 @@ mod tests {
             let tree = PointTree::new(&points);
             // One buffer across queries and k: the previous answer seeds each search bound.
             let mut found = Neighbours::default();
+            let mut stack = SearchStack::default();
             let mut previous = None;
             for _ in 0..50 {
                 let q = DVec3::new(rng.random(), rng.random(), rng.random()) * 2.4 - DVec3::ONE;
@@ -525,12 +560,12 @@ mod tests {
                 }
                 for hint in [None, previous, Some(0)] {
                     assert_eq!(
-                        tree.nearest_one(q, hint),
+                        tree.nearest_one(q, hint, &mut stack),
                         Some(brute(&points, q, 1)[0].1),
                         "nearest one, n {n}"
                     );
                 }
-                previous = tree.nearest_one(q, None);
+                previous = tree.nearest_one(q, None, &mut stack);
             }
         }
     }
@@ -544,6 +579,7 @@ mod tests {
         let points = stress_points(&mut rng, n);
         let tree = PointTree::new(&points);
         let mut found = Neighbours::default();
+        let mut stack = SearchStack::default();
         let mut hint = None;
         for (step, &id) in tree.spatial_order().iter().enumerate().step_by(3) {
             let jitter = if step % 2 == 0 { 0.0 } else { 1e-3 };
@@ -553,7 +589,7 @@ mod tests {
                 tree.nearest_n(q, k, &mut found);
                 assert_eq!(found.items().collect::<Vec<_>>(), brute(&points, q, k));
             }
-            let nearest = tree.nearest_one(q, hint);
+            let nearest = tree.nearest_one(q, hint, &mut stack);
             assert_eq!(nearest, Some(brute(&points, q, 1)[0].1));
             hint = nearest;
         }
@@ -599,7 +635,10 @@ mod tests {
     #[test]
     fn empty_tree_and_zero_k_give_nothing() {
         let tree = PointTree::new(&[]);
-        assert_eq!(tree.nearest_one(DVec3::ZERO, Some(3)), None);
+        assert_eq!(
+            tree.nearest_one(DVec3::ZERO, Some(3), &mut SearchStack::default()),
+            None
+        );
         let tree = PointTree::new(&[DVec3::X]);
         let mut found = Neighbours::default();
         tree.nearest_n(DVec3::ZERO, 0, &mut found);
