@@ -154,10 +154,17 @@ fn build(entries: &mut [([f32; 3], u32)], start: usize, nodes: &mut Vec<Node>) {
     }
     let mut lo = [f32::INFINITY; 3];
     let mut hi = [f32::NEG_INFINITY; 3];
+    // Plain comparisons instead of `f32::min`/`max`, whose NaN handling the finite coordinates
+    // do not need (a `−0`/`+0` tie may keep either zero: the extents, hence the axis, are the
+    // same).
     for (c, _) in entries.iter() {
         for a in 0..3 {
-            lo[a] = lo[a].min(c[a]);
-            hi[a] = hi[a].max(c[a]);
+            if c[a] < lo[a] {
+                lo[a] = c[a];
+            }
+            if c[a] > hi[a] {
+                hi[a] = c[a];
+            }
         }
     }
     let extent = [hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]];
