@@ -304,11 +304,18 @@ impl PointTree {
         let q = to_f32(query);
         let mut limit = f32::INFINITY;
         if k > 0 && found.keys.len() == k {
-            // The previous k neighbours all lie within `limit` of the new query.
+            // The previous k neighbours all lie within `limit` of the new query. A plain
+            // comparison instead of `f32::max`, which likewise leaves the limit as it is for a
+            // NaN distance (a query beyond f32), without the extra NaN test.
             limit = 0.0;
             for &key in &found.keys {
                 match self.coords_by_id.get(key as u32 as usize) {
-                    Some(c) => limit = limit.max(distance2(c, &q)),
+                    Some(c) => {
+                        let d2 = distance2(c, &q);
+                        if d2 > limit {
+                            limit = d2;
+                        }
+                    }
                     None => limit = f32::INFINITY,
                 }
             }
