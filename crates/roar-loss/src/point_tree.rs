@@ -9,8 +9,11 @@
 
 use glam::DVec3;
 
-/// Points per leaf: small enough to prune well, large enough to amortize the descent.
-const LEAF_SIZE: usize = 16;
+/// Points per leaf: small enough to prune well, large enough to amortize the descent. Measured
+/// on the planar loss (one evaluation, callgrind, rabbit and moebius at 5000 faces): 24 takes
+/// about 1% fewer instructions than 16 or 32, 8 and 20 1.5-5% more. The answers do not
+/// depend on it.
+const LEAF_SIZE: usize = 24;
 
 /// Subtrees with at least this many points build their two halves in parallel.
 const PARALLEL_BUILD: usize = 16_384;
