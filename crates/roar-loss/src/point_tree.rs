@@ -557,13 +557,15 @@ mod tests {
     #[test]
     fn matches_brute_force_in_f32_including_duplicates() {
         let mut rng = ChaCha8Rng::seed_from_u64(3);
-        // 40 000 points exercise the parallel build.
-        for n in [1usize, 5, 13, 100, 2000, 40_000] {
+        // One buffer and one stack across queries, k and trees: the previous answer seeds each
+        // search bound (also when it comes from another tree, whose indices may be out of this
+        // one's range), and stack slots left by earlier searches must not leak into later ones.
+        let mut found = Neighbours::default();
+        let mut stack = SearchStack::default();
+        // 40 000 points exercise the parallel build; sizes up and down.
+        for n in [2000usize, 1, 40_000, 13, 100, 5] {
             let points = stress_points(&mut rng, n);
             let tree = PointTree::new(&points);
-            // One buffer across queries and k: the previous answer seeds each search bound.
-            let mut found = Neighbours::default();
-            let mut stack = SearchStack::default();
             let mut previous = None;
             for _ in 0..50 {
                 let q = DVec3::new(rng.random(), rng.random(), rng.random()) * 2.4 - DVec3::ONE;
