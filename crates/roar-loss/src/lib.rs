@@ -13,6 +13,7 @@ pub use knn_projector::{KnnOptions, KnnPlanarProjector, PlanarMode};
 pub use planar::{PlanarLoss, PlanarOptions, PlanarStats};
 
 use glam::DVec3;
+use rayon::prelude::*;
 
 pub mod point_cloud;
 pub mod render_loss;
@@ -66,7 +67,7 @@ pub trait Loss: Send {
 /// A weighted sum of losses, itself a [`Loss`] (spec §3.2.3: `3·L_render + 1·L_planar`).
 #[derive(Default)]
 pub struct WeightedSum {
-    /// The terms and their weights, evaluated in this order.
+    /// The terms and their weights; evaluated concurrently, summed in this order.
     pub terms: Vec<(f64, Box<dyn Loss>)>,
     /// The last evaluation's weighted value of each term (for reports), in term order.
     pub last_values: Vec<f64>,
@@ -90,11 +91,19 @@ impl Loss for WeightedSum {
         positions: &[DVec3],
         triangles: &[[u32; 3]],
     ) -> Result<(f64, Vec<DVec3>), LossError> {
+        // The terms run concurrently: each is deterministic on its own and their results are
+        // added in term order, so the sum does not depend on the schedule, while one term's
+        // serial stretches (sorting, tree builds, reductions) overlap the other's parallel work.
+        let results: Vec<Result<(f64, Vec<DVec3>), LossError>> = self
+            .terms
+            .par_iter_mut()
+            .map(|(_, loss)| loss.value_and_grad(positions, triangles))
+            .collect();
         let mut total = 0.0;
         let mut gradient = vec![DVec3::ZERO; positions.len()];
         self.last_values.clear();
-        for (weight, loss) in &mut self.terms {
-            let (value, grad) = loss.value_and_grad(positions, triangles)?;
+        for ((weight, _), result) in self.terms.iter().zip(results) {
+            let (value, grad) = result?;
             total += *weight * value;
             self.last_values.push(*weight * value);
             for (g, d) in gradient.iter_mut().zip(&grad) {
@@ -132,6 +141,32 @@ mod tests {
             let value = positions.iter().map(|p| self.0 * p.length_squared()).sum();
             Ok((value, positions.iter().map(|p| 2.0 * self.0 * *p).collect()))
         }
+    }
+
+    /// Always fails, naming itself.
+    struct Failing(&'static str);
+
+    impl Loss for Failing {
+        fn name(&self) -> &'static str {
+            self.0
+        }
+        fn value_and_grad(
+            &mut self,
+            _: &[DVec3],
+            _: &[[u32; 3]],
+        ) -> Result<(f64, Vec<DVec3>), LossError> {
+            Err(LossError::InvalidTarget(self.0.to_string()))
+        }
+    }
+
+    #[test]
+    fn weighted_sum_reports_the_first_failing_term_in_term_order() {
+        let mut sum = WeightedSum::default()
+            .with(1.0, Box::new(Quadratic(1.0)))
+            .with(1.0, Box::new(Failing("second")))
+            .with(1.0, Box::new(Failing("third")));
+        let err = sum.value_and_grad(&[DVec3::ONE], &[]).unwrap_err();
+        assert_eq!(err.to_string(), "invalid target: second");
     }
 
     #[test]
