@@ -3,11 +3,11 @@
 //! 2-manifold with exactly the budget, no self-intersecting faces, no more components than the
 //! init, and a Chamfer distance below that of the init decimated to the same budget (what the
 //! optimization adds): at least 10 % below on trimesh-rabbit and luke-f-16, and not above it on
-//! the example, where the init + QEM is already about as close as roar gets: since the QEM has
-//! planar quadrics, the box-shaped init decimated to 1000 faces is about as close as roar gets
-//! (this test's Chamfer/diag: 2.40e-3 against roar's 2.37e-3; it was 4.28e-3 before; the
-//! one-sided distances agree within 2 %: what is left is the sheet's thickness and the soup's
-//! interior faces, which no closed surface comes nearer to).
+//! the example: since the QEM has planar quadrics, the box-shaped init decimated to 1000 faces
+//! is already about as close as roar gets (this test's Chamfer/diag: 2.40e-3 against roar's
+//! 2.37e-3; it was 4.28e-3 before; the one-sided distances agree within 2 %: what is left is
+//! the sheet's thickness and the soup's interior faces, which no closed surface comes nearer
+//! to).
 //!
 //! Measured with the eleventh session's code (init at 192 voxels; in release): the example
 //! 2.40e-3 → 2.37e-3 (−1.0 %), trimesh-rabbit 2.87e-3 → 2.40e-3 (−16.3 %), luke-f-16 1.64e-3 →
