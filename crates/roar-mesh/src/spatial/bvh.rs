@@ -55,7 +55,7 @@ pub struct RayHit {
     pub barycentric: [f64; 3],
 }
 
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 struct Node {
     aabb: Aabb,
     /// Leaf: first index into `faces`. Inner node: index of the first child.
@@ -87,7 +87,8 @@ impl TriangleBvh {
     /// Builds the tree.
     ///
     /// Inputs: `positions` (#V), `triangles` (#F, indices into `positions`). Output: a tree over
-    /// every face whose indices are in range and whose corners are finite. O(#F log #F).
+    /// every face whose indices are in range and whose corners are finite. O(#F log #F); the
+    /// upper levels build their halves in parallel (the same tree whatever the thread count).
     pub fn build(positions: &[DVec3], triangles: &[[u32; 3]]) -> TriangleBvh {
         let n_vertices = positions.len();
         let mut faces: Vec<u32> = Vec::with_capacity(triangles.len());
@@ -111,50 +112,10 @@ impl TriangleBvh {
             nodes: Vec::new(),
             faces,
         };
-        bvh.build_nodes(&boxes, &centroids);
+        if !bvh.faces.is_empty() {
+            bvh.nodes = build_subtree(&mut bvh.faces, 0, &boxes, &centroids);
+        }
         bvh
-    }
-
-    fn build_nodes(&mut self, boxes: &[Aabb], centroids: &[DVec3]) {
-        if self.faces.is_empty() {
-            return;
-        }
-        self.nodes
-            .reserve(2 * self.faces.len() / MAX_LEAF_FACES + 1);
-        self.nodes.push(Node {
-            aabb: Aabb::EMPTY,
-            start: 0,
-            count: 0,
-        });
-        let mut stack = vec![(0usize, 0usize, self.faces.len())];
-        while let Some((node, start, end)) = stack.pop() {
-            let range = &mut self.faces[start..end];
-            let mut aabb = Aabb::EMPTY;
-            let mut centroid_box = Aabb::EMPTY;
-            for &f in range.iter() {
-                aabb = aabb.union(&boxes[f as usize]);
-                centroid_box.grow(centroids[f as usize]);
-            }
-            self.nodes[node].aabb = aabb;
-            if range.len() <= MAX_LEAF_FACES {
-                self.nodes[node].start = start as u32;
-                self.nodes[node].count = range.len() as u32;
-                continue;
-            }
-            let mid = start + split(range, boxes, centroids, &centroid_box);
-            let first_child = self.nodes.len();
-            for _ in 0..2 {
-                self.nodes.push(Node {
-                    aabb: Aabb::EMPTY,
-                    start: 0,
-                    count: 0,
-                });
-            }
-            self.nodes[node].start = first_child as u32;
-            self.nodes[node].count = 0;
-            stack.push((first_child + 1, mid, end));
-            stack.push((first_child, start, mid));
-        }
     }
 
     /// Updates the boxes after the vertices moved; the tree shape is kept (same topology).
@@ -519,6 +480,107 @@ impl TriangleBvh {
     }
 }
 
+/// Ranges of at least this many faces build their two halves in parallel.
+const PARALLEL_BUILD: usize = 4096;
+
+/// The nodes of the subtree over `faces` (positions `first_face..` of the tree's face order), its
+/// root first. Layout, as a depth-first build that allocates both children of a node together
+/// makes it: `[root][left child][right child][left's descendants][right's descendants]`, inner
+/// nodes pointing at their first child by absolute index within the returned vector. Large
+/// ranges build their halves in parallel and splice them in, which gives the same nodes as
+/// the serial build (the split depends on the faces only), so the tree does not depend on the
+/// number of threads.
+fn build_subtree(
+    faces: &mut [u32],
+    first_face: usize,
+    boxes: &[Aabb],
+    centroids: &[DVec3],
+) -> Vec<Node> {
+    if faces.len() < PARALLEL_BUILD {
+        return build_serial(faces, first_face, boxes, centroids);
+    }
+    let (aabb, centroid_box) = bounds(faces, boxes, centroids);
+    let mid = split(faces, boxes, centroids, &centroid_box);
+    let (left, right) = faces.split_at_mut(mid);
+    let (left, right) = rayon::join(
+        || build_subtree(left, first_face, boxes, centroids),
+        || build_subtree(right, first_face + mid, boxes, centroids),
+    );
+    // Node `i` of `left` goes to `i + 2` when `i ≥ 1` (after the root and the child pair) and
+    // to 1 when it is left's root; node `i ≥ 1` of `right` goes after all of left's nodes.
+    let shift = |node: Node, by: usize| Node {
+        start: if node.is_leaf() {
+            node.start
+        } else {
+            node.start + by as u32
+        },
+        ..node
+    };
+    let (left_by, right_by) = (2, left.len() + 1);
+    let mut nodes = Vec::with_capacity(1 + left.len() + right.len());
+    nodes.push(Node {
+        aabb,
+        start: 1,
+        count: 0,
+    });
+    nodes.push(shift(left[0], left_by));
+    nodes.push(shift(right[0], right_by));
+    nodes.extend(left[1..].iter().map(|&n| shift(n, left_by)));
+    nodes.extend(right[1..].iter().map(|&n| shift(n, right_by)));
+    nodes
+}
+
+/// [`build_subtree`] on one thread: an explicit stack, left child first.
+fn build_serial(
+    faces: &mut [u32],
+    first_face: usize,
+    boxes: &[Aabb],
+    centroids: &[DVec3],
+) -> Vec<Node> {
+    let mut nodes = Vec::with_capacity(2 * faces.len() / MAX_LEAF_FACES + 1);
+    nodes.push(Node {
+        aabb: Aabb::EMPTY,
+        start: 0,
+        count: 0,
+    });
+    let mut stack = vec![(0usize, 0usize, faces.len())];
+    while let Some((node, start, end)) = stack.pop() {
+        let range = &mut faces[start..end];
+        let (aabb, centroid_box) = bounds(range, boxes, centroids);
+        nodes[node].aabb = aabb;
+        if range.len() <= MAX_LEAF_FACES {
+            nodes[node].start = (first_face + start) as u32;
+            nodes[node].count = range.len() as u32;
+            continue;
+        }
+        let mid = start + split(range, boxes, centroids, &centroid_box);
+        let first_child = nodes.len();
+        for _ in 0..2 {
+            nodes.push(Node {
+                aabb: Aabb::EMPTY,
+                start: 0,
+                count: 0,
+            });
+        }
+        nodes[node].start = first_child as u32;
+        nodes[node].count = 0;
+        stack.push((first_child + 1, mid, end));
+        stack.push((first_child, start, mid));
+    }
+    nodes
+}
+
+/// The box of `faces` and the box of their centroids.
+fn bounds(faces: &[u32], boxes: &[Aabb], centroids: &[DVec3]) -> (Aabb, Aabb) {
+    let mut aabb = Aabb::EMPTY;
+    let mut centroid_box = Aabb::EMPTY;
+    for &f in faces {
+        aabb = aabb.union(&boxes[f as usize]);
+        centroid_box.grow(centroids[f as usize]);
+    }
+    (aabb, centroid_box)
+}
+
 /// Reorders `faces` so that `faces[..k]` and `faces[k..]` are the two children; returns `k`
 /// with `0 < k < faces.len()`.
 fn split(faces: &mut [u32], boxes: &[Aabb], centroids: &[DVec3], centroid_box: &Aabb) -> usize {
@@ -627,5 +689,45 @@ impl SlabRay {
             t_out = t_out.min(far * (1.0 + 4.0 * f64::EPSILON));
         }
         (t_in <= t_out).then_some(t_in)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The parallel build splices its halves into exactly the nodes and face order of the
+    /// one-thread build (a wrong offset would point an inner node at another subtree).
+    #[test]
+    fn parallel_build_gives_the_serial_tree() {
+        // A pseudo-random soup of small triangles, large enough for two levels of splicing.
+        let mut state = 0x9e37_79b9_7f4a_7c15_u64;
+        let mut next = || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let n = 5 * PARALLEL_BUILD;
+        let mut boxes = Vec::with_capacity(n);
+        let mut centroids = Vec::with_capacity(n);
+        for _ in 0..n {
+            let c = DVec3::new(next(), next(), next());
+            let corners = [
+                c,
+                c + 0.01 * DVec3::new(next(), next(), 0.0),
+                c + 0.01 * DVec3::Z,
+            ];
+            let b = Aabb::from_triangle(corners);
+            centroids.push(b.center());
+            boxes.push(b);
+        }
+        let mut parallel_faces: Vec<u32> = (0..n as u32).collect();
+        let mut serial_faces = parallel_faces.clone();
+        let parallel = build_subtree(&mut parallel_faces, 0, &boxes, &centroids);
+        let serial = build_serial(&mut serial_faces, 0, &boxes, &centroids);
+        assert!(parallel.len() > 2 * n / MAX_LEAF_FACES / 2);
+        assert_eq!(parallel_faces, serial_faces);
+        assert_eq!(parallel, serial);
     }
 }
