@@ -506,8 +506,9 @@ fn build_subtree(
         || build_subtree(left, first_face, boxes, centroids),
         || build_subtree(right, first_face + mid, boxes, centroids),
     );
-    // Node `i` of `left` goes to `i + 2` when `i ≥ 1` (after the root and the child pair) and
-    // to 1 when it is left's root; node `i ≥ 1` of `right` goes after all of left's nodes.
+    // The two roots go to 1 and 2. Node `i ≥ 1` of `left` goes to `i + 2` (after the root and
+    // the pair), node `i ≥ 1` of `right` to `i + left.len() + 1` (after all of left's), so
+    // every inner node's child index (never a root: always `≥ 1`) shifts by the same amount.
     let shift = |node: Node, by: usize| Node {
         start: if node.is_leaf() {
             node.start
