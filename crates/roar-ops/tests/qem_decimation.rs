@@ -409,3 +409,85 @@ fn timing_100k_to_5k() {
     );
     assert_eq!(m.n_faces(), 5000);
 }
+
+#[test]
+fn strips_of_degenerate_caps_on_creases_are_collapsed_first() {
+    // A strip of caps: zero-width faces whose corners lie on a crease line, as the
+    // optimization leaves them. Made on a gridded box by splitting a crease edge (a, b) at m₁
+    // (a third of the way) and m₂ (two thirds), nudging both by 1e-9 so the caps' normals are
+    // rounding noise rather than exactly zero, and flipping the new edges (m₁, c), (m₂, c):
+    //
+    //   c-side faces (a, m₁, c) (m₁, m₂, c) (m₂, b, c)  ==>  (a, b, c) + caps (a, m₁, m₂) (a, m₂, b)
+    //
+    // The surface does not change. Removing a cap makes its neighbour in the strip part of the
+    // collapse's fan, unchanged or nearly: a noisy normal that must not veto, a ratio that must
+    // not be compared as if it meant something.
+    let mut m = gridded_box([6, 6, 6], [1.0, 1.0, 1.0]);
+    let creases: Vec<_> = m
+        .edges()
+        .filter(|&e| {
+            let h = e.halfedge();
+            m.face_normal(m.face(h))
+                .dot(m.face_normal(m.face(h.twin())))
+                < 0.5
+        })
+        .collect();
+    let mut used = std::collections::HashSet::new();
+    let mut strips = 0;
+    for e in creases {
+        let ends = m.edge_vertices(e);
+        if ends.iter().any(|v| used.contains(v)) {
+            continue;
+        }
+        used.extend(ends);
+        let first = m.split_edge(e, 1.0 / 3.0);
+        // The split edge keeps its id and now joins a and m₁; (m₁, b) is the first new edge.
+        let second = m.split_edge(first.new_edges[0], 0.5);
+        let nudge = [
+            glam::DVec3::new(1e-9, -1e-9, 1e-9),
+            glam::DVec3::splat(-1e-9),
+        ];
+        for (split, d) in [first, second].iter().zip(nudge) {
+            let v = split.new_vertex;
+            m.set_position(v, m.position(v) + d);
+        }
+        m.flip(first.new_edges[1]).expect("(m₁, c) flips");
+        m.flip(second.new_edges[1]).expect("(m₂, c) flips");
+        strips += 1;
+    }
+    assert!(strips >= 8, "{strips} strips");
+    assert!(aspect_percentiles(&m)[2] > 1e6, "the caps are degenerate");
+    let overlapping = roar_mesh::spatial::count_intersecting_faces(&m);
+    assert!(overlapping > 0, "a strip's caps overlap each other");
+
+    // Removing as many faces as the strips hold (each cap goes with one face across the
+    // crease) leaves no cap, hence no overlap (`decimate_and_check` counts them).
+    let n = m.n_faces();
+    let m = decimate_and_check(&m, n - 4 * strips);
+    let [_, _, worst] = aspect_percentiles(&m);
+    assert!(worst < 10.0, "worst aspect ratio {worst}");
+    // The box is unchanged: every vertex still lies on its surface.
+    for v in m.vertices() {
+        let p = m.position(v);
+        let off = p.min_element().abs().min((p.max_element() - 1.0).abs());
+        assert!(off < 1e-4, "vertex {p} off the box");
+    }
+}
+
+#[test]
+fn a_degenerate_limit_below_the_quality_bounds_is_refused_by_name() {
+    for limit in [5.0, f64::INFINITY, f64::NAN] {
+        let options = DecimateOptions {
+            degenerate_quality: limit,
+            ..DecimateOptions::default()
+        };
+        let mut m = icosphere(2);
+        match decimate(&mut m, 100, &options) {
+            Err(DecimateError::InvalidOption { name, .. }) => {
+                assert_eq!(name, "degenerate_quality")
+            }
+            other => panic!("limit {limit}: {other:?}"),
+        }
+        assert_eq!(m.n_faces(), 320, "the mesh is untouched");
+    }
+}
