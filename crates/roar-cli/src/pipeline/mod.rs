@@ -154,16 +154,17 @@ pub struct RunStats {
     /// Collapses of the finish's QEMs (to 2N first when the mesh has more faces, see
     /// `finish_budgets`, then to N).
     pub final_collapses: usize,
-    /// Vertices moved the whole `final_qem_offset` before the finish's QEMs, summed (the others were
-    /// shortened or kept where a full move would have made faces intersect).
+    /// Vertices moved the whole `final_qem_offset` before the finish's QEMs, summed (the others
+    /// were shortened or kept where a full move would have made faces intersect).
     pub offset_vertices: usize,
-    /// Vertex moves of the tangential smoothing after the finish's QEMs, summed (`final_smoothing_sweeps`;
-    /// 0 also when the smoothed mesh was dropped because it would have intersected itself).
+    /// Vertex moves of the tangential smoothing after the finish's QEMs, summed
+    /// (`final_smoothing_sweeps`; 0 also when the smoothed mesh was dropped because it would
+    /// have intersected itself).
     pub final_smoothing_moves: usize,
     /// Loss, terms and faces at every polish iteration (after each of the finish's QEMs).
     pub polish_history: Vec<IterationRecord>,
-    /// Whether the last polished mesh was kept (false: it intersected itself, or no polish ran; true
-    /// also when its best state was the unpolished one).
+    /// Whether the last polished mesh was kept (false: it intersected itself, or no polish ran;
+    /// true also when its best state was the unpolished one).
     pub polish_kept: bool,
     /// Sliver flips in the output (`sliver_quality`; 0 also when they were undone because the
     /// written mesh would have intersected itself).
