@@ -9,9 +9,10 @@
 //! the sheet's thickness and the soup's interior faces, which no closed surface comes nearer
 //! to).
 //!
-//! Measured with the eleventh session's code (init at 192 voxels; in release): the example
-//! 2.40e-3 → 2.37e-3 (−1.0 %), trimesh-rabbit 2.87e-3 → 2.40e-3 (−16.3 %), luke-f-16 1.64e-3 →
-//! 1.45e-3 (−11.5 %). With the sixth session's init at 128 voxels: trimesh-rabbit 3.31e-3 →
+//! Measured with the twelfth session's code (init at 192 voxels, the finish through 2N; in
+//! release): the example 2.40e-3 → 2.37e-3 (−1.1 %), trimesh-rabbit 2.87e-3 → 2.40e-3
+//! (−16.2 %), luke-f-16 1.64e-3 → 1.40e-3 (−14.6 %; −11.5 % with the eleventh session's
+//! one-step finish). With the sixth session's init at 128 voxels: trimesh-rabbit 3.31e-3 →
 //! 2.39e-3 (−27.8 %), luke-f-16 1.89e-3 → 1.51e-3 (−19.9 %): the finer init is closer to the
 //! input, so the optimization's margin over it is smaller.
 //!
