@@ -475,7 +475,7 @@ fn strips_of_degenerate_caps_on_creases_are_collapsed_first() {
 }
 
 #[test]
-fn a_degenerate_limit_below_the_quality_bounds_is_refused_by_name() {
+fn a_degenerate_limit_below_the_last_bound_or_not_finite_is_refused_by_name() {
     for limit in [5.0, f64::INFINITY, f64::NAN] {
         let options = DecimateOptions {
             degenerate_quality: limit,
