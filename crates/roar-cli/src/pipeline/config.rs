@@ -151,8 +151,9 @@ pub struct ReconstructConfig {
     /// Runs only when `iterations > 0`, so `--iterations 0` stays the plain init + QEM.
     pub polish_iterations: usize,
     /// Last step: flip the edges of faces with aspect ratio `Q = R/(2r)` above this when both
-    /// faces of the edge get better, the two are nearly coplanar (0.95) and no intersection
-    /// appears (`roar_ops::slivers`; 0 = off). [INF] Not in the paper: the optimization and
+    /// faces of the edge get better, the two are nearly coplanar (0.95; against the other face
+    /// alone when one is degenerate, above 100) and no intersection appears
+    /// (`roar_ops::slivers`; 0 = off). [INF] Not in the paper: the optimization and
     /// the polish move vertices for the losses, and the final QEM bounds only the faces it
     /// creates, so a few caps (one angle near 180°) reach the output. Runs only when
     /// `iterations > 0`.
