@@ -30,7 +30,9 @@ pub struct ReconstructConfig {
     /// resolution, OQ-12). The init closes gaps of one voxel and the loop never changes the
     /// genus, so this decides which slots and holes of the input survive: 192 keeps gaps down to
     /// about diag/170 on a box-like shape, on a par with alpha wrapping at α = diag/300, where
-    /// `roar init`'s 128 fills the slots between a chair's slats.
+    /// `roar init`'s 128 fills the slots between a chair's slats. 256 opens narrower cavities
+    /// (libigl-camelhead's ears) and costs 3–5 s more on the wild meshes, but gains less than it
+    /// gives roar's own init + QEM (docs/evaluation.md, thirteenth session).
     pub init_resolution: usize,
     /// The init is decimated to at most this many faces (§4.1: 20k).
     pub init_max_faces: usize,
@@ -109,7 +111,11 @@ pub struct ReconstructConfig {
     /// Sweeps of tangential smoothing at exactly N after the final QEM, before the polish
     /// (0 = none), each moved vertex put back on its old faces (§3.9 plus projection) and every
     /// move limited so that no intersection appears. [INF] Not in the paper: with the sweeps
-    /// off in the loop, this is what keeps the output's triangles well shaped.
+    /// off in the loop, this is what keeps the output's triangles well shaped. Without it the
+    /// outputs are slightly closer to the input (Chamfer/diag 0.5–1 % lower on
+    /// gpytoolbox-split_mountain and libigl-camelhead at 5000 faces) but worse shaped (median
+    /// aspect ratio over the 14 wild meshes 1.46 with the init at 256 voxels, against 1.26 with
+    /// the sweeps at 192; docs/evaluation.md, thirteenth session).
     pub final_smoothing_sweeps: usize,
     /// Every this many iterations, keep a copy of the loop's mesh and its loss (0 = only the
     /// last state). The run finishes from the kept state with the lowest loss (the last one
