@@ -1,0 +1,164 @@
+//! Degenerate-face collapses for a finished mesh: remove a face with aspect ratio above a limit
+//! by collapsing one of its edges, when no flip can (see [`crate::slivers`]).
+//!
+//! A sliver flip fixes a cap whose long edge has a good face across it. It cannot fix a needle
+//! (a very short edge: flipping a long edge leaves the short one), nor a cap whose neighbour
+//! across the long edge is itself a sliver (a strip of caps along a crease, where every flip
+//! makes another cap). Collapsing an edge of the face removes it and its neighbour across that
+//! edge; the tail vertex `a` merges into the head `b`, which keeps its position:
+//!
+//! ```text
+//!        c                 c
+//!       / \                |
+//!      /   \      a → b    |
+//!     a-----b     ====>    b        (faces (a, b, c) and (b, a, d) removed;
+//!      \   /               |         every other face at a now ends at b)
+//!       \ /                |
+//!        d                 d
+//! ```
+//!
+//! For a needle (`a` close to `b`), or a cap whose apex `a` lies on the line of a crease between
+//! the other two, the faces around `a` keep their planes, so the surface barely moves. A
+//! collapse of half-edge `a → b` is applied when
+//! 1. it is topologically legal ([`Mesh::can_collapse`]);
+//! 2. every reshaped face (around `a`, except the two removed) that was not degenerate keeps
+//!    its normal within `min_normal_dot` (a degenerate face's old normal is rounding noise);
+//! 3. no reshaped face is degenerate afterwards, so every collapse lowers the number of
+//!    degenerate faces and the process ends;
+//! 4. no reshaped face intersects another face ([`IntersectionGuard`], exact).
+//!
+//! The edges of a degenerate face are tried shortest first, each in both directions. Each
+//! collapse removes two faces; the caller restores the face count (the pipeline splits the
+//! longest edges, which moves no geometry).
+
+use crate::block::BlockStats;
+use crate::geometry::{triangle_normal, triangle_quality};
+use crate::guard::IntersectionGuard;
+use roar_mesh::{FaceId, HalfedgeId, Mesh};
+
+/// Options of [`collapse_degenerate_faces`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct DegenerateOptions {
+    /// Faces with `Q = R/(2r)` at or above this (or NaN, fully collapsed) are degenerate.
+    /// Default 100, the QEM's [`crate::qem::DecimateOptions::degenerate_quality`].
+    pub min_quality: f64,
+    /// Every reshaped face that was not degenerate keeps `n_new · n_old ≥` this. Default 0.95
+    /// (the flat test of the sliver flips).
+    pub min_normal_dot: f64,
+    /// Most rounds over the degenerate faces. Default 5.
+    pub max_rounds: usize,
+}
+
+impl Default for DegenerateOptions {
+    fn default() -> Self {
+        DegenerateOptions {
+            min_quality: 100.0,
+            min_normal_dot: 0.95,
+            max_rounds: 5,
+        }
+    }
+}
+
+/// Collapses edges of degenerate faces as the module doc says. Keeps the mesh valid and, if it
+/// was free of self-intersections, keeps it so; removes two faces per collapse.
+///
+/// Stats: `candidates` = degenerate faces looked at; `accepted` = collapses; `rejected` (per
+/// half-edge tried): `"topology"`, `"normal"`, `"quality"`, `"intersection"`.
+pub fn collapse_degenerate_faces(mesh: &mut Mesh, options: &DegenerateOptions) -> BlockStats {
+    let mut stats = BlockStats::new("degenerate_collapses");
+    let degenerate = |q: f64| q.is_nan() || q >= options.min_quality;
+    let mut guard: Option<IntersectionGuard> = None;
+    for _ in 0..options.max_rounds {
+        let faces: Vec<FaceId> = mesh
+            .faces()
+            .filter(|&f| degenerate(face_quality(mesh, f)))
+            .collect();
+        let mut collapsed = 0;
+        for f in faces {
+            if !mesh.is_face_alive(f) || !degenerate(face_quality(mesh, f)) {
+                continue;
+            }
+            stats.candidates += 1;
+            for h in halfedges_shortest_first(mesh, f) {
+                if mesh.can_collapse(h).is_err() {
+                    stats.reject("topology", 1);
+                    continue;
+                }
+                if let Err(reason) = reshaped_faces_ok(mesh, h, options) {
+                    stats.reject(reason, 1);
+                    continue;
+                }
+                let guard = guard.get_or_insert_with(|| IntersectionGuard::new(mesh));
+                let head = mesh.head(h);
+                if guard.collapse_intersects(mesh, h, mesh.position(head)) {
+                    stats.reject("intersection", 1);
+                    continue;
+                }
+                let done = mesh
+                    .collapse(h)
+                    .expect("degenerate collapse passed can_collapse (invariant)");
+                for f in done.removed_faces {
+                    guard.mark(f);
+                }
+                guard.mark_around(mesh, done.survivor);
+                collapsed += 1;
+                break;
+            }
+        }
+        stats.accepted += collapsed;
+        if collapsed == 0 {
+            break;
+        }
+    }
+    stats
+}
+
+fn face_quality(mesh: &Mesh, f: FaceId) -> f64 {
+    triangle_quality(mesh.face_vertices(f).map(|v| mesh.position(v)))
+}
+
+/// The six half-edges of `f` and their twins, by increasing edge length (ties by id order).
+fn halfedges_shortest_first(mesh: &Mesh, f: FaceId) -> Vec<HalfedgeId> {
+    let first = mesh.halfedge_of_face(f);
+    let mut edges = [first, mesh.next(first), mesh.next(mesh.next(first))];
+    edges.sort_by(|&x, &y| {
+        let length = |h: HalfedgeId| {
+            mesh.position(mesh.tail(h))
+                .distance(mesh.position(mesh.head(h)))
+        };
+        length(x).total_cmp(&length(y))
+    });
+    edges.iter().flat_map(|&h| [h, h.twin()]).collect()
+}
+
+/// Tests 2 and 3 of the module doc for collapsing `h` (its tail onto its head's position).
+fn reshaped_faces_ok(
+    mesh: &Mesh,
+    h: HalfedgeId,
+    options: &DegenerateOptions,
+) -> Result<(), &'static str> {
+    let (a, b) = (mesh.tail(h), mesh.head(h));
+    let removed = [mesh.face(h), mesh.face(h.twin())];
+    let pb = mesh.position(b);
+    for f in mesh.faces_around(a) {
+        if removed.contains(&f) {
+            continue;
+        }
+        let old = mesh.face_vertices(f).map(|v| mesh.position(v));
+        let new = mesh
+            .face_vertices(f)
+            .map(|v| if v == a { pb } else { mesh.position(v) });
+        let q_new = triangle_quality(new);
+        if q_new.is_nan() || q_new >= options.min_quality {
+            return Err("quality");
+        }
+        let q_old = triangle_quality(old);
+        let trusted = q_old < options.min_quality;
+        let turn =
+            triangle_normal(old[0], old[1], old[2]).dot(triangle_normal(new[0], new[1], new[2]));
+        if trusted && turn < options.min_normal_dot {
+            return Err("normal");
+        }
+    }
+    Ok(())
+}

@@ -1,0 +1,95 @@
+//! Degenerate-face collapses: a planted needle, which no sliver flip fixes, is collapsed away
+//! without moving a vertex; on random meshes with planted caps and needles the collapses keep
+//! the mesh valid, only lower the number of degenerate faces, and never create an intersection.
+
+mod blocks_common;
+
+use blocks_common::random_mesh;
+use proptest::prelude::*;
+use roar_mesh::shapes::icosphere;
+use roar_mesh::spatial::count_intersecting_faces;
+use roar_mesh::{EdgeId, Mesh};
+use roar_ops::degenerate::{DegenerateOptions, collapse_degenerate_faces};
+use roar_ops::geometry::triangle_quality;
+use roar_ops::slivers::{SliverOptions, flip_slivers};
+
+fn degenerate_faces(mesh: &Mesh) -> usize {
+    mesh.faces()
+        .map(|f| triangle_quality(mesh.face_vertices(f).map(|v| mesh.position(v))))
+        .filter(|q| q.is_nan() || *q >= 100.0)
+        .count()
+}
+
+/// Bit patterns of every live vertex position.
+fn positions(mesh: &Mesh) -> Vec<[u64; 3]> {
+    let mut keys: Vec<[u64; 3]> = mesh
+        .vertices()
+        .map(|v| mesh.position(v).to_array().map(f64::to_bits))
+        .collect();
+    keys.sort();
+    keys
+}
+
+/// Splits `e` at `t` from its first end: with `t` near 0, two needles.
+fn plant_needle(mesh: &mut Mesh, e: EdgeId, t: f64) {
+    mesh.split_edge(e, t);
+}
+
+#[test]
+fn a_needle_that_no_flip_fixes_is_collapsed_away_without_moving_a_vertex() {
+    let mut mesh = icosphere(3);
+    let e = mesh.edges().next().unwrap();
+    plant_needle(&mut mesh, e, 1e-3);
+    assert_eq!(degenerate_faces(&mesh), 2);
+    let mut flipped = mesh.clone();
+    flip_slivers(&mut flipped, &SliverOptions::default());
+    assert_eq!(degenerate_faces(&flipped), 2, "a flip fixed the needles");
+
+    let before = positions(&mesh);
+    let faces = mesh.n_faces();
+    let stats = collapse_degenerate_faces(&mut mesh, &DegenerateOptions::default());
+    assert_eq!(stats.accepted, 1, "{stats:?}");
+    mesh.validate().unwrap();
+    assert_eq!(mesh.n_faces(), faces - 2);
+    assert_eq!(degenerate_faces(&mesh), 0);
+    assert_eq!(count_intersecting_faces(&mesh), 0);
+    let after = positions(&mesh);
+    assert!(after.iter().all(|p| before.binary_search(p).is_ok()));
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(24))]
+    #[test]
+    fn degenerate_collapses_keep_the_mesh_valid_and_only_remove_degenerate_faces(
+        kind in 0u8..4,
+        jitter in 0.0f64..0.05,
+        seed in 0u64..1000,
+        plants in proptest::collection::vec((0usize..1000, 1e-4f64..0.02, any::<bool>()), 1..12),
+    ) {
+        let mut mesh = random_mesh(kind, jitter, seed);
+        for (pick, closeness, needle) in plants {
+            if needle {
+                let e = mesh.edges().nth(pick % mesh.n_edges()).unwrap();
+                plant_needle(&mut mesh, e, closeness);
+            } else {
+                let f = mesh.faces().nth(pick % mesh.n_faces()).unwrap();
+                let w = 0.5 * (1.0 - closeness);
+                mesh.split_face(f, [w, w, closeness]);
+            }
+        }
+        let clean = count_intersecting_faces(&mesh) == 0;
+        let (faces, euler, degenerate) =
+            (mesh.n_faces(), mesh.euler_characteristic(), degenerate_faces(&mesh));
+        let before = positions(&mesh);
+        let stats = collapse_degenerate_faces(&mut mesh, &DegenerateOptions::default());
+        prop_assert!(mesh.validate().is_ok());
+        prop_assert_eq!(mesh.n_faces(), faces - 2 * stats.accepted);
+        prop_assert_eq!(mesh.euler_characteristic(), euler);
+        prop_assert!(degenerate_faces(&mesh) + stats.accepted <= degenerate);
+        let after = positions(&mesh);
+        prop_assert!(after.iter().all(|p| before.binary_search(p).is_ok()));
+        if clean {
+            prop_assert_eq!(count_intersecting_faces(&mesh), 0);
+        }
+    }
+}
