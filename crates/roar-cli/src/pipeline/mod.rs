@@ -29,6 +29,7 @@ use roar_mesh::spatial::{Aabb, Normalization, self_intersecting_faces};
 use roar_mesh::{EdgeId, Mesh};
 use roar_ops::block::{Block, BlockContext, BlockStats};
 use roar_ops::collapse_block::{FaceCollapse, FaceCollapseOptions};
+use roar_ops::degenerate::{DegenerateOptions, collapse_degenerate_faces};
 use roar_ops::flips::FlipOptions;
 use roar_ops::init::{InitError, InitOptions, InitialMeshOptions};
 use roar_ops::optim::{Optimizer, OptimizerOptions};
@@ -169,6 +170,9 @@ pub struct RunStats {
     /// Sliver flips in the output (`sliver_quality`; 0 also when they were undone because the
     /// written mesh would have intersected itself).
     pub sliver_flips: usize,
+    /// Edge collapses that removed degenerate faces no flip could, each followed by a split of a
+    /// longest edge to keep the face count (0 also when undone, as `sliver_flips`).
+    pub degenerate_collapses: usize,
 }
 
 /// One iteration of the optimize stage, as the report lists it.
@@ -381,7 +385,7 @@ impl Reconstruction {
         }
         drop(loss);
         if config.iterations > 0 && config.sliver_quality > 0.0 {
-            mesh = flip_slivers_if_clean(mesh, &target.normalization, &config, &mut stats);
+            mesh = remove_slivers_if_clean(mesh, &target.normalization, &config, &mut stats);
             clock.lap("sliver_flips");
         }
 
@@ -663,26 +667,35 @@ fn polish(
     Ok(if clean { best } else { mesh })
 }
 
-/// The sliver flips of `roar_ops::slivers` on the final mesh, kept only if the result is free of
-/// self-intersections in the input's coordinates, where it will be written (the flips are
-/// checked exactly in the normalized ones; undoing the normalization rounds).
-fn flip_slivers_if_clean(
+/// The sliver flips of `roar_ops::slivers` on the final mesh; then, for the degenerate faces
+/// they leave, the collapses of `roar_ops::degenerate`, the face count restored by splitting
+/// longest edges (which moves no geometry), and the flips once more. Kept only if the result is
+/// free of self-intersections in the input's coordinates, where it will be written (everything
+/// is checked exactly in the normalized ones; undoing the normalization rounds).
+fn remove_slivers_if_clean(
     mesh: Mesh,
     normalization: &Normalization,
     config: &ReconstructConfig,
     stats: &mut RunStats,
 ) -> Mesh {
-    let mut flipped = mesh.clone();
+    let mut cleaned = mesh.clone();
     let options = SliverOptions {
         max_quality: config.sliver_quality,
         ..SliverOptions::default()
     };
-    let block = flip_slivers(&mut flipped, &options);
-    if block.accepted == 0 || !clean_in_output_coordinates(&flipped, normalization) {
+    let mut flips = flip_slivers(&mut cleaned, &options).accepted;
+    let faces = cleaned.n_faces();
+    let collapses = collapse_degenerate_faces(&mut cleaned, &DegenerateOptions::default()).accepted;
+    if collapses > 0 {
+        fill_to_budget(&mut cleaned, faces);
+        flips += flip_slivers(&mut cleaned, &options).accepted;
+    }
+    if flips + collapses == 0 || !clean_in_output_coordinates(&cleaned, normalization) {
         return mesh;
     }
-    stats.sliver_flips = block.accepted;
-    flipped
+    stats.sliver_flips = flips;
+    stats.degenerate_collapses = collapses;
+    cleaned
 }
 
 /// Whether `mesh`, with the normalization undone (as it will be written), is free of
