@@ -66,16 +66,15 @@ impl Default for DegenerateOptions {
 /// half-edge tried): `"topology"`, `"normal"`, `"quality"`, `"intersection"`.
 pub fn collapse_degenerate_faces(mesh: &mut Mesh, options: &DegenerateOptions) -> BlockStats {
     let mut stats = BlockStats::new("degenerate_collapses");
-    let degenerate = |q: f64| q.is_nan() || q >= options.min_quality;
     let mut guard: Option<IntersectionGuard> = None;
     for _ in 0..options.max_rounds {
         let faces: Vec<FaceId> = mesh
             .faces()
-            .filter(|&f| degenerate(face_quality(mesh, f)))
+            .filter(|&f| is_degenerate(face_quality(mesh, f), options))
             .collect();
         let mut collapsed = 0;
         for f in faces {
-            if !mesh.is_face_alive(f) || !degenerate(face_quality(mesh, f)) {
+            if !mesh.is_face_alive(f) || !is_degenerate(face_quality(mesh, f), options) {
                 continue;
             }
             stats.candidates += 1;
@@ -113,11 +112,17 @@ pub fn collapse_degenerate_faces(mesh: &mut Mesh, options: &DegenerateOptions) -
     stats
 }
 
+/// NaN (a fully collapsed face) counts as degenerate.
+fn is_degenerate(quality: f64, options: &DegenerateOptions) -> bool {
+    quality.is_nan() || quality >= options.min_quality
+}
+
 fn face_quality(mesh: &Mesh, f: FaceId) -> f64 {
     triangle_quality(mesh.face_vertices(f).map(|v| mesh.position(v)))
 }
 
-/// The six half-edges of `f` and their twins, by increasing edge length (ties by id order).
+/// The three half-edges of `f`, each followed by its twin, by increasing edge length (ties keep
+/// the face's order).
 fn halfedges_shortest_first(mesh: &Mesh, f: FaceId) -> Vec<HalfedgeId> {
     let first = mesh.halfedge_of_face(f);
     let mut edges = [first, mesh.next(first), mesh.next(mesh.next(first))];
@@ -148,12 +153,10 @@ fn reshaped_faces_ok(
         let new = mesh
             .face_vertices(f)
             .map(|v| if v == a { pb } else { mesh.position(v) });
-        let q_new = triangle_quality(new);
-        if q_new.is_nan() || q_new >= options.min_quality {
+        if is_degenerate(triangle_quality(new), options) {
             return Err("quality");
         }
-        let q_old = triangle_quality(old);
-        let trusted = q_old < options.min_quality;
+        let trusted = !is_degenerate(triangle_quality(old), options);
         let turn =
             triangle_normal(old[0], old[1], old[2]).dot(triangle_normal(new[0], new[1], new[2]));
         if trusted && turn < options.min_normal_dot {
