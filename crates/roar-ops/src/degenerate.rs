@@ -32,7 +32,7 @@
 //! longest edges, which moves no geometry).
 
 use crate::block::BlockStats;
-use crate::geometry::{triangle_normal, triangle_quality};
+use crate::geometry::{is_degenerate, triangle_normal, triangle_quality};
 use crate::guard::IntersectionGuard;
 use roar_mesh::{FaceId, HalfedgeId, Mesh};
 
@@ -70,11 +70,12 @@ pub fn collapse_degenerate_faces(mesh: &mut Mesh, options: &DegenerateOptions) -
     for _ in 0..options.max_rounds {
         let faces: Vec<FaceId> = mesh
             .faces()
-            .filter(|&f| is_degenerate(face_quality(mesh, f), options))
+            .filter(|&f| is_degenerate(face_quality(mesh, f), options.min_quality))
             .collect();
         let mut collapsed = 0;
         for f in faces {
-            if !mesh.is_face_alive(f) || !is_degenerate(face_quality(mesh, f), options) {
+            if !mesh.is_face_alive(f) || !is_degenerate(face_quality(mesh, f), options.min_quality)
+            {
                 continue;
             }
             stats.candidates += 1;
@@ -110,11 +111,6 @@ pub fn collapse_degenerate_faces(mesh: &mut Mesh, options: &DegenerateOptions) -
         }
     }
     stats
-}
-
-/// NaN (a fully collapsed face) counts as degenerate.
-fn is_degenerate(quality: f64, options: &DegenerateOptions) -> bool {
-    quality.is_nan() || quality >= options.min_quality
 }
 
 fn face_quality(mesh: &Mesh, f: FaceId) -> f64 {
@@ -153,10 +149,10 @@ fn reshaped_faces_ok(
         let new = mesh
             .face_vertices(f)
             .map(|v| if v == a { pb } else { mesh.position(v) });
-        if is_degenerate(triangle_quality(new), options) {
+        if is_degenerate(triangle_quality(new), options.min_quality) {
             return Err("quality");
         }
-        let trusted = !is_degenerate(triangle_quality(old), options);
+        let trusted = !is_degenerate(triangle_quality(old), options.min_quality);
         let turn =
             triangle_normal(old[0], old[1], old[2]).dot(triangle_normal(new[0], new[1], new[2]));
         if trusted && turn < options.min_normal_dot {

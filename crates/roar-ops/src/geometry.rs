@@ -45,6 +45,13 @@ pub fn triangle_quality(p: [DVec3; 3]) -> f64 {
     }
 }
 
+/// Whether a triangle of quality `q` (see [`triangle_quality`]) is degenerate: at or above
+/// `limit`, or NaN (fully collapsed). Such a face's normal is rounding noise, which the sliver
+/// flips and the degenerate collapses must not trust.
+pub fn is_degenerate(q: f64, limit: f64) -> bool {
+    q.is_nan() || q >= limit
+}
+
 /// Geometry of one mesh state, indexed by slot id (spec §2.2).
 #[derive(Debug, Clone, Default)]
 pub struct Geometry {

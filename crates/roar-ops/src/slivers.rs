@@ -33,7 +33,7 @@
 //! Edges are visited in id order, rounds repeat until a round flips nothing (or `max_rounds`).
 
 use crate::block::BlockStats;
-use crate::geometry::{triangle_normal, triangle_quality};
+use crate::geometry::{is_degenerate, triangle_normal, triangle_quality};
 use crate::guard::IntersectionGuard;
 use glam::DVec3;
 use roar_mesh::Mesh;
@@ -133,8 +133,7 @@ fn keeps_surface(
     options: &SliverOptions,
 ) -> Result<(), &'static str> {
     let new = [(pd - pa).cross(pc - pa), (pc - pb).cross(pd - pb)];
-    // NaN (a fully collapsed face) counts as degenerate.
-    let degenerate = |q: f64| q.is_nan() || q >= options.degenerate_quality;
+    let degenerate = |q: f64| is_degenerate(q, options.degenerate_quality);
     let (q_l, q_r) = (
         triangle_quality([pa, pb, pc]),
         triangle_quality([pb, pa, pd]),

@@ -935,6 +935,7 @@ mod tests {
     use super::*;
     use roar_mesh::shapes::icosphere;
     use roar_mesh::spatial::count_intersecting_faces;
+    use roar_ops::geometry::triangle_quality;
 
     #[test]
     fn the_finish_halves_through_2n_only_from_above_2n_and_when_polishing() {
@@ -942,6 +943,30 @@ mod tests {
         assert_eq!(finish_budgets(2000, 1000, true), vec![1000]);
         assert_eq!(finish_budgets(10000, 5000, true), vec![5000]);
         assert_eq!(finish_budgets(5000, 1000, false), vec![1000]);
+    }
+
+    #[test]
+    fn the_last_stage_removes_a_needle_and_keeps_the_face_count() {
+        let mut mesh = icosphere(3);
+        let e = mesh.edges().next().unwrap();
+        // Splitting an edge next to its end makes two needles (aspect ratio far above 100).
+        mesh.split_edge(e, 1e-3);
+        mesh.compact();
+        let faces = mesh.n_faces();
+        let worst = |mesh: &Mesh| {
+            mesh.faces()
+                .map(|f| triangle_quality(mesh.face_vertices(f).map(|v| mesh.position(v))))
+                .fold(1.0, f64::max)
+        };
+        assert!(worst(&mesh) > 100.0);
+        let mut stats = RunStats::default();
+        let config = ReconstructConfig::default();
+        let mesh = remove_slivers_if_clean(mesh, &Normalization::IDENTITY, &config, &mut stats);
+        assert_eq!(stats.degenerate_collapses, 1, "{stats:?}");
+        mesh.validate().unwrap();
+        assert_eq!(mesh.n_faces(), faces);
+        assert!(worst(&mesh) < 100.0, "worst aspect ratio {}", worst(&mesh));
+        assert_eq!(count_intersecting_faces(&mesh), 0);
     }
 
     /// Two unit icospheres whose centres are `distance` apart, as one mesh of two pieces.

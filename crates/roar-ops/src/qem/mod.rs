@@ -39,6 +39,7 @@ mod heap;
 mod quadric;
 mod split;
 
+use crate::geometry::is_degenerate;
 use crate::intersect::{PreparedFace, certainly_apart, faces_intersect_filtered, fan_is_embedded};
 use glam::DVec3;
 use grid::{Box32, FaceGrid};
@@ -792,7 +793,7 @@ impl<'m, F: FnMut(&Collapse)> Decimator<'m, F> {
             let cross_old = (old[1] - old[0]).cross(old[2] - old[0]);
             if cross_old.length() > 0.0
                 && cross_old.normalize().dot(cross_new.normalize()) <= self.options.min_normal_dot
-                && triangle_quality(old) < self.options.degenerate_quality
+                && !is_degenerate(triangle_quality(old), self.options.degenerate_quality)
             {
                 return Verdict::Refuse(Veto::NormalFlip);
             }
