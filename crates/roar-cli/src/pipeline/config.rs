@@ -59,7 +59,8 @@ pub struct ReconstructConfig {
     /// 3·render ≈ 3.1e-3, raw planar ≈ 1.3e-6–3.1e-6, Laplacian ≈ 3e-4–6e-4; at 500 the planar
     /// term (6e-4–1.5e-3) is within 5× of the render term instead of 500× below it.
     pub planar_scale: f64,
-    /// Source samples kept per planar loss evaluation (§3.2.2 cap).
+    /// Source samples kept per planar loss evaluation (§3.2.2 cap; the default and why:
+    /// `roar_loss::planar::DEFAULT_MAX_SAMPLES`).
     pub planar_max_samples: usize,
     /// Neighbours of the k-NN planar projection (§8: s2t_neighbours 10).
     pub planar_neighbours: usize,
@@ -189,7 +190,7 @@ impl Default for ReconstructConfig {
             render_weight: 3.0,
             planar_weight: 1.0,
             planar_scale: 500.0,
-            planar_max_samples: 100_000,
+            planar_max_samples: roar_loss::planar::DEFAULT_MAX_SAMPLES,
             planar_neighbours: 10,
             planar_t2s: true,
             point_cloud_samples: 200_000,
