@@ -23,8 +23,9 @@
 //! 1. it is topologically legal ([`Mesh::can_collapse`]);
 //! 2. every reshaped face (around `a`, except the two removed) that was not degenerate keeps
 //!    its normal within `min_normal_dot` (a degenerate face's old normal is rounding noise);
-//! 3. no reshaped face is degenerate afterwards, so every collapse lowers the number of
-//!    degenerate faces and the process ends;
+//! 3. no reshaped face that was not degenerate becomes degenerate (one that was may stay so:
+//!    in a cluster of close vertices every collapse keeps some needle of the cluster a
+//!    needle), so every collapse lowers the number of degenerate faces and the process ends;
 //! 4. no reshaped face intersects another face ([`IntersectionGuard`], exact).
 //!
 //! The edges of a degenerate face are tried shortest first, each in both directions. Each
@@ -149,13 +150,16 @@ fn reshaped_faces_ok(
         let new = mesh
             .face_vertices(f)
             .map(|v| if v == a { pb } else { mesh.position(v) });
+        if is_degenerate(triangle_quality(old), options.min_quality) {
+            // It may stay degenerate, and its old normal is rounding noise.
+            continue;
+        }
         if is_degenerate(triangle_quality(new), options.min_quality) {
             return Err("quality");
         }
-        let trusted = !is_degenerate(triangle_quality(old), options.min_quality);
         let turn =
             triangle_normal(old[0], old[1], old[2]).dot(triangle_normal(new[0], new[1], new[2]));
-        if trusted && turn < options.min_normal_dot {
+        if turn < options.min_normal_dot {
             return Err("normal");
         }
     }

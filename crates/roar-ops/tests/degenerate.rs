@@ -8,7 +8,7 @@ use blocks_common::random_mesh;
 use proptest::prelude::*;
 use roar_mesh::shapes::icosphere;
 use roar_mesh::spatial::count_intersecting_faces;
-use roar_mesh::{EdgeId, Mesh};
+use roar_mesh::{EdgeId, Mesh, VertexId};
 use roar_ops::degenerate::{DegenerateOptions, collapse_degenerate_faces};
 use roar_ops::geometry::triangle_quality;
 use roar_ops::slivers::{SliverOptions, flip_slivers};
@@ -52,6 +52,43 @@ fn a_needle_that_no_flip_fixes_is_collapsed_away_without_moving_a_vertex() {
     mesh.validate().unwrap();
     assert_eq!(mesh.n_faces(), faces - 2);
     assert_eq!(degenerate_faces(&mesh), 0);
+    assert_eq!(count_intersecting_faces(&mesh), 0);
+    let after = positions(&mesh);
+    assert!(after.iter().all(|p| before.binary_search(p).is_ok()));
+}
+
+/// Splits the edge from `from` to `to` at `t` of its length from `from`; returns the new vertex.
+fn split_near(mesh: &mut Mesh, from: VertexId, to: VertexId, t: f64) -> VertexId {
+    let h = mesh.find_halfedge(from, to).unwrap();
+    let e = mesh.edge(h);
+    let t = if mesh.edge_vertices(e)[0] == from {
+        t
+    } else {
+        1.0 - t
+    };
+    mesh.split_edge(e, t).new_vertex
+}
+
+#[test]
+fn a_cluster_where_every_collapse_keeps_another_needle_is_still_collapsed_away() {
+    // Three vertices u, v, w within 1e-4 of an edge length of each other, inside one face
+    // (p, q, r): the needles (r, v, u), (v, q, w) and (w, r, u). Whichever short edge
+    // collapses, a needle of the cluster stays a needle, so a rule that refuses any degenerate
+    // reshaped face refuses them all; a needle may stay one as long as no face becomes one.
+    let mut mesh = icosphere(3);
+    let f = mesh.faces().next().unwrap();
+    let split = mesh.split_face(f, [1.0 / 3.0; 3]);
+    let (u, [p, q, _]) = (split.new_vertex, split.parents);
+    split_near(&mut mesh, u, p, 1e-4);
+    split_near(&mut mesh, u, q, 1e-4);
+    assert_eq!(degenerate_faces(&mesh), 3);
+
+    let before = positions(&mesh);
+    let faces = mesh.n_faces();
+    let stats = collapse_degenerate_faces(&mut mesh, &DegenerateOptions::default());
+    mesh.validate().unwrap();
+    assert_eq!(degenerate_faces(&mesh), 0, "{stats:?}");
+    assert_eq!(mesh.n_faces(), faces - 2 * stats.accepted);
     assert_eq!(count_intersecting_faces(&mesh), 0);
     let after = positions(&mesh);
     assert!(after.iter().all(|p| before.binary_search(p).is_ok()));
