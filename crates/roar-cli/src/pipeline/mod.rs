@@ -31,6 +31,7 @@ use roar_ops::block::{Block, BlockContext, BlockStats};
 use roar_ops::collapse_block::{FaceCollapse, FaceCollapseOptions};
 use roar_ops::degenerate::{DegenerateOptions, collapse_degenerate_faces};
 use roar_ops::flips::FlipOptions;
+use roar_ops::geometry::{is_degenerate, triangle_quality};
 use roar_ops::init::{InitError, InitOptions, InitialMeshOptions};
 use roar_ops::optim::{Optimizer, OptimizerOptions};
 use roar_ops::qem::{DecimateError, DecimateOptions, DecimateStats, decimate};
@@ -718,13 +719,26 @@ fn compact_triangles(mesh: &mut Mesh, optimizer: &mut Optimizer) -> Vec<[u32; 3]
         .collect()
 }
 
-/// Splits the longest edges at their midpoints until the mesh has `faces` faces (each split adds
-/// two). The geometry does not change, so no intersection can appear. Returns the split count.
+/// Splits edges at their midpoints until the mesh has `faces` faces (each split adds two),
+/// longest first, and in each pass only edges that are the longest of both their faces, between
+/// two faces that are not degenerate (aspect ratio above 100, as in the QEM): halving such an
+/// edge keeps the new faces about as well shaped as the old ones (longest-edge bisection),
+/// while halving a needle's edge leaves two needles and halving a cap's short side a flatter
+/// cap, which would undo the degenerate collapses this fill follows. The mesh's longest edge is
+/// the longest of both its faces, so a pass finds one unless it borders a degenerate face; then
+/// the longest edge is split anyway. The geometry does not change, so no intersection can
+/// appear. Returns the split count.
 fn fill_to_budget(mesh: &mut Mesh, faces: usize) -> usize {
     let mut splits = 0;
     while mesh.n_faces() < faces {
-        let mut edges: Vec<(f64, EdgeId)> =
-            mesh.edges().map(|e| (mesh.edge_length(e), e)).collect();
+        let mut edges: Vec<(f64, EdgeId)> = mesh
+            .edges()
+            .filter(|&e| bisects_well(mesh, e))
+            .map(|e| (mesh.edge_length(e), e))
+            .collect();
+        if edges.is_empty() {
+            edges = mesh.edges().map(|e| (mesh.edge_length(e), e)).collect();
+        }
         // Longest first; ties by id keep it deterministic.
         edges.sort_by(|a, b| b.0.total_cmp(&a.0).then(a.1.cmp(&b.1)));
         let wanted = (faces - mesh.n_faces()) / 2;
@@ -738,6 +752,22 @@ fn fill_to_budget(mesh: &mut Mesh, faces: usize) -> usize {
     }
     mesh.compact();
     splits
+}
+
+/// Whether halving `e` leaves no degenerate face: neither face of `e` is degenerate (aspect
+/// ratio above 100, as in the QEM), nor is any of the four faces the split would make (see
+/// [`fill_to_budget`]).
+fn bisects_well(mesh: &Mesh, e: EdgeId) -> bool {
+    let limit = DegenerateOptions::default().min_quality;
+    let h = mesh.edge_halfedge(e);
+    [h, h.twin()].into_iter().all(|h| {
+        let (a, b) = (mesh.position(mesh.tail(h)), mesh.position(mesh.head(h)));
+        let c = mesh.position(mesh.head(mesh.next(h)));
+        let m = 0.5 * (a + b);
+        [[a, b, c], [a, m, c], [m, b, c]]
+            .into_iter()
+            .all(|t| !is_degenerate(triangle_quality(t), limit))
+    })
 }
 
 /// Fills the mesh up to `config.faces`, runs the untangle block and fills again (its collapses
@@ -967,6 +997,41 @@ mod tests {
         assert_eq!(mesh.n_faces(), faces);
         assert!(worst(&mesh) < 100.0, "worst aspect ratio {}", worst(&mesh));
         assert_eq!(count_intersecting_faces(&mesh), 0);
+    }
+
+    #[test]
+    fn the_fill_splits_no_edge_of_a_needle_even_when_it_is_the_longest() {
+        // A spike makes the edges at one vertex the longest of the mesh; a needle planted on
+        // one of them (split next to the spike's tip) borders the longest edges.
+        let mut mesh = icosphere(1);
+        let tip = mesh.vertices().next().unwrap();
+        mesh.set_position(tip, 1.6 * mesh.position(tip));
+        let spoke = mesh
+            .edges()
+            .find(|&e| mesh.edge_vertices(e)[0] == tip)
+            .unwrap();
+        mesh.split_edge(spoke, 1e-4);
+        let degenerate = |mesh: &Mesh| {
+            mesh.faces()
+                .filter(|&f| {
+                    let corners = mesh.face_vertices(f).map(|v| mesh.position(v));
+                    is_degenerate(triangle_quality(corners), 100.0)
+                })
+                .count()
+        };
+        assert_eq!(degenerate(&mesh), 2);
+        let longest = mesh
+            .edges()
+            .max_by(|&a, &b| mesh.edge_length(a).total_cmp(&mesh.edge_length(b)))
+            .unwrap();
+        assert!(!bisects_well(&mesh, longest), "the setup lost its point");
+
+        let faces = mesh.n_faces() + 20;
+        let splits = fill_to_budget(&mut mesh, faces);
+        assert_eq!(splits, 10);
+        mesh.validate().unwrap();
+        assert_eq!(mesh.n_faces(), faces);
+        assert_eq!(degenerate(&mesh), 2, "a split made a degenerate face");
     }
 
     /// Two unit icospheres whose centres are `distance` apart, as one mesh of two pieces.
