@@ -720,14 +720,11 @@ fn compact_triangles(mesh: &mut Mesh, optimizer: &mut Optimizer) -> Vec<[u32; 3]
 }
 
 /// Splits edges at their midpoints until the mesh has `faces` faces (each split adds two),
-/// longest first, and in each pass only edges that are the longest of both their faces, between
-/// two faces that are not degenerate (aspect ratio above 100, as in the QEM): halving such an
-/// edge keeps the new faces about as well shaped as the old ones (longest-edge bisection),
-/// while halving a needle's edge leaves two needles and halving a cap's short side a flatter
-/// cap, which would undo the degenerate collapses this fill follows. The mesh's longest edge is
-/// the longest of both its faces, so a pass finds one unless it borders a degenerate face; then
-/// the longest edge is split anyway. The geometry does not change, so no intersection can
-/// appear. Returns the split count.
+/// longest first, skipping edges whose halving would leave a degenerate face
+/// ([`bisects_well`]): halving a needle's long edge leaves two needles and halving a flat
+/// cap's edge can make a flatter one, which would undo the degenerate collapses this fill
+/// follows. When no edge qualifies the longest is split anyway, so the fill always ends. The
+/// geometry does not change, so no intersection can appear. Returns the split count.
 fn fill_to_budget(mesh: &mut Mesh, faces: usize) -> usize {
     let mut splits = 0;
     while mesh.n_faces() < faces {
