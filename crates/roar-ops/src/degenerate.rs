@@ -33,7 +33,7 @@
 //! longest edges, which moves no geometry).
 
 use crate::block::BlockStats;
-use crate::geometry::{is_degenerate, triangle_normal, triangle_quality};
+use crate::geometry::{DEGENERATE_QUALITY, is_degenerate, triangle_normal, triangle_quality};
 use crate::guard::IntersectionGuard;
 use roar_mesh::{FaceId, HalfedgeId, Mesh};
 
@@ -41,7 +41,8 @@ use roar_mesh::{FaceId, HalfedgeId, Mesh};
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct DegenerateOptions {
     /// Faces with `Q = R/(2r)` at or above this (or NaN, fully collapsed) are degenerate.
-    /// Default 100, the QEM's [`crate::qem::DecimateOptions::degenerate_quality`].
+    /// Default [`DEGENERATE_QUALITY`] (100), as the QEM's
+    /// [`crate::qem::DecimateOptions::degenerate_quality`].
     pub min_quality: f64,
     /// Every reshaped face that was not degenerate keeps `n_new · n_old ≥` this. Default 0.95
     /// (the flat test of the sliver flips).
@@ -53,7 +54,7 @@ pub struct DegenerateOptions {
 impl Default for DegenerateOptions {
     fn default() -> Self {
         DegenerateOptions {
-            min_quality: 100.0,
+            min_quality: DEGENERATE_QUALITY,
             min_normal_dot: 0.95,
             max_rounds: 5,
         }

@@ -45,6 +45,11 @@ pub fn triangle_quality(p: [DVec3; 3]) -> f64 {
     }
 }
 
+/// The quality (`Q = R/(2r)`, see [`triangle_quality`]) from which a face counts as degenerate,
+/// the default of the QEM, the sliver flips, the degenerate collapses and the pipeline's fill:
+/// above it a face's normal is rounding noise.
+pub const DEGENERATE_QUALITY: f64 = 100.0;
+
 /// Whether a triangle of quality `q` (see [`triangle_quality`]) is degenerate: at or above
 /// `limit`, or NaN (fully collapsed). Such a face's normal is rounding noise, which the sliver
 /// flips and the degenerate collapses must not trust.

@@ -62,7 +62,7 @@ impl Default for SliverOptions {
         SliverOptions {
             max_quality: 10.0,
             min_abs_flatness: 0.95,
-            degenerate_quality: 100.0,
+            degenerate_quality: crate::geometry::DEGENERATE_QUALITY,
             max_rounds: 5,
         }
     }

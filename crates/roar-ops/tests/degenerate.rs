@@ -10,13 +10,13 @@ use roar_mesh::shapes::icosphere;
 use roar_mesh::spatial::count_intersecting_faces;
 use roar_mesh::{EdgeId, Mesh, VertexId};
 use roar_ops::degenerate::{DegenerateOptions, collapse_degenerate_faces};
-use roar_ops::geometry::triangle_quality;
+use roar_ops::geometry::{DEGENERATE_QUALITY, is_degenerate, triangle_quality};
 use roar_ops::slivers::{SliverOptions, flip_slivers};
 
 fn degenerate_faces(mesh: &Mesh) -> usize {
     mesh.faces()
         .map(|f| triangle_quality(mesh.face_vertices(f).map(|v| mesh.position(v))))
-        .filter(|q| q.is_nan() || *q >= 100.0)
+        .filter(|&q| is_degenerate(q, DEGENERATE_QUALITY))
         .count()
 }
 

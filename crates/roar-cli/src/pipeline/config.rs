@@ -161,8 +161,8 @@ pub struct ReconstructConfig {
     /// faces of the edge get better, the two are nearly coplanar (0.95; against the other face
     /// alone when one is degenerate, above 100) and no intersection appears
     /// (`roar_ops::slivers`; 0 = off); then degenerate faces (above 100) that no flip fixes are
-    /// removed by collapsing one of their edges, and the face count is restored by splitting
-    /// longest edges (`roar_ops::degenerate`). [INF] Not in the paper: the optimization and
+    /// removed by collapsing one of their edges, and the face count is restored by edge splits
+    /// that make no degenerate face (`roar_ops::degenerate`). [INF] Not in the paper: the optimization and
     /// the polish move vertices for the losses, and the final QEM bounds only the faces it
     /// creates, so a few caps (one angle near 180°) reach the output. Runs only when
     /// `iterations > 0`.

@@ -31,7 +31,7 @@ use roar_ops::block::{Block, BlockContext, BlockStats};
 use roar_ops::collapse_block::{FaceCollapse, FaceCollapseOptions};
 use roar_ops::degenerate::{DegenerateOptions, collapse_degenerate_faces};
 use roar_ops::flips::FlipOptions;
-use roar_ops::geometry::{is_degenerate, triangle_quality};
+use roar_ops::geometry::{DEGENERATE_QUALITY, is_degenerate, triangle_quality};
 use roar_ops::init::{InitError, InitOptions, InitialMeshOptions};
 use roar_ops::optim::{Optimizer, OptimizerOptions};
 use roar_ops::qem::{DecimateError, DecimateOptions, DecimateStats, decimate};
@@ -171,8 +171,8 @@ pub struct RunStats {
     /// Sliver flips in the output (`sliver_quality`; 0 also when they were undone because the
     /// written mesh would have intersected itself).
     pub sliver_flips: usize,
-    /// Edge collapses that removed degenerate faces no flip could, each followed by a split of a
-    /// longest edge to keep the face count (0 also when undone, as `sliver_flips`).
+    /// Edge collapses that removed degenerate faces no flip could, each followed by an edge
+    /// split to keep the face count (0 also when undone, as `sliver_flips`).
     pub degenerate_collapses: usize,
 }
 
@@ -669,8 +669,8 @@ fn polish(
 }
 
 /// The sliver flips of `roar_ops::slivers` on the final mesh; then, for the degenerate faces
-/// they leave, the collapses of `roar_ops::degenerate`, the face count restored by splitting
-/// longest edges (which moves no geometry), and the flips once more. Kept only if the result is
+/// they leave, the collapses of `roar_ops::degenerate`, the face count restored by edge splits
+/// ([`fill_to_budget`], which moves no geometry), and the flips once more. Kept only if the result is
 /// free of self-intersections in the input's coordinates, where it will be written (everything
 /// is checked exactly in the normalized ones; undoing the normalization rounds).
 fn remove_slivers_if_clean(
@@ -751,11 +751,9 @@ fn fill_to_budget(mesh: &mut Mesh, faces: usize) -> usize {
     splits
 }
 
-/// Whether halving `e` leaves no degenerate face: neither face of `e` is degenerate (aspect
-/// ratio above 100, as in the QEM), nor is any of the four faces the split would make (see
-/// [`fill_to_budget`]).
+/// Whether halving `e` leaves no degenerate face ([`DEGENERATE_QUALITY`]): neither face of `e`
+/// is degenerate, nor is any of the four faces the split would make (see [`fill_to_budget`]).
 fn bisects_well(mesh: &Mesh, e: EdgeId) -> bool {
-    let limit = DegenerateOptions::default().min_quality;
     let h = mesh.edge_halfedge(e);
     [h, h.twin()].into_iter().all(|h| {
         let (a, b) = (mesh.position(mesh.tail(h)), mesh.position(mesh.head(h)));
@@ -763,7 +761,7 @@ fn bisects_well(mesh: &Mesh, e: EdgeId) -> bool {
         let m = 0.5 * (a + b);
         [[a, b, c], [a, m, c], [m, b, c]]
             .into_iter()
-            .all(|t| !is_degenerate(triangle_quality(t), limit))
+            .all(|t| !is_degenerate(triangle_quality(t), DEGENERATE_QUALITY))
     })
 }
 
@@ -962,7 +960,16 @@ mod tests {
     use super::*;
     use roar_mesh::shapes::icosphere;
     use roar_mesh::spatial::count_intersecting_faces;
-    use roar_ops::geometry::triangle_quality;
+
+    /// Faces at or above [`DEGENERATE_QUALITY`].
+    fn degenerate_faces(mesh: &Mesh) -> usize {
+        mesh.faces()
+            .filter(|&f| {
+                let corners = mesh.face_vertices(f).map(|v| mesh.position(v));
+                is_degenerate(triangle_quality(corners), DEGENERATE_QUALITY)
+            })
+            .count()
+    }
 
     #[test]
     fn the_finish_halves_through_2n_only_from_above_2n_and_when_polishing() {
@@ -980,19 +987,14 @@ mod tests {
         mesh.split_edge(e, 1e-3);
         mesh.compact();
         let faces = mesh.n_faces();
-        let worst = |mesh: &Mesh| {
-            mesh.faces()
-                .map(|f| triangle_quality(mesh.face_vertices(f).map(|v| mesh.position(v))))
-                .fold(1.0, f64::max)
-        };
-        assert!(worst(&mesh) > 100.0);
+        assert_eq!(degenerate_faces(&mesh), 2);
         let mut stats = RunStats::default();
         let config = ReconstructConfig::default();
         let mesh = remove_slivers_if_clean(mesh, &Normalization::IDENTITY, &config, &mut stats);
         assert_eq!(stats.degenerate_collapses, 1, "{stats:?}");
         mesh.validate().unwrap();
         assert_eq!(mesh.n_faces(), faces);
-        assert!(worst(&mesh) < 100.0, "worst aspect ratio {}", worst(&mesh));
+        assert_eq!(degenerate_faces(&mesh), 0);
         assert_eq!(count_intersecting_faces(&mesh), 0);
     }
 
@@ -1008,15 +1010,7 @@ mod tests {
             .find(|&e| mesh.edge_vertices(e)[0] == tip)
             .unwrap();
         mesh.split_edge(spoke, 1e-4);
-        let degenerate = |mesh: &Mesh| {
-            mesh.faces()
-                .filter(|&f| {
-                    let corners = mesh.face_vertices(f).map(|v| mesh.position(v));
-                    is_degenerate(triangle_quality(corners), 100.0)
-                })
-                .count()
-        };
-        assert_eq!(degenerate(&mesh), 2);
+        assert_eq!(degenerate_faces(&mesh), 2);
         let longest = mesh
             .edges()
             .max_by(|&a, &b| mesh.edge_length(a).total_cmp(&mesh.edge_length(b)))
@@ -1028,7 +1022,7 @@ mod tests {
         assert_eq!(splits, 10);
         mesh.validate().unwrap();
         assert_eq!(mesh.n_faces(), faces);
-        assert_eq!(degenerate(&mesh), 2, "a split made a degenerate face");
+        assert_eq!(degenerate_faces(&mesh), 2, "a split made a degenerate face");
     }
 
     /// Two unit icospheres whose centres are `distance` apart, as one mesh of two pieces.

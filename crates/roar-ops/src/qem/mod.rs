@@ -121,7 +121,7 @@ impl Default for DecimateOptions {
             quality_penalty_above: 2.0,
             planar_weight: 1e-3,
             crease_weight: 1.0,
-            degenerate_quality: 100.0,
+            degenerate_quality: crate::geometry::DEGENERATE_QUALITY,
             check_self_intersections: true,
             max_passes_per_bound: 8,
             best_effort: false,
