@@ -1,7 +1,8 @@
 //! The supplementary's Fig. 1 (spec §3.2.2, §7.2): error and time of the k-NN planar projection
 //! (spec §3.4 (A)) with 10k, 50k and 200k target samples against the exact ray-cast projection
 //! onto the target mesh (spec §3.4 (B)), for source meshes of about 1k, 10k and 100k faces; plus
-//! the per-evaluation cost of the planar loss (value and gradient) at 5k faces.
+//! the per-evaluation cost of the planar loss (value and gradient) at 5k faces, at the default
+//! sample cap and at the previous 100k.
 //!
 //! Target: a bumpy sphere (icosphere(6), 81 920 faces, radius 0.8 modulated by
 //! `1 + 0.04·sin(6x)sin(6y)sin(6z)`). Sources: geodesic spheres of 980, 9 680 and 100 820 faces
@@ -185,19 +186,27 @@ fn bench_planar_loss(c: &mut Criterion) {
     let cloud = sample_surface(&tp, &tt, 50_000, 11);
     let (sp, st) = icosphere(4).to_triangles();
     let sp: Vec<DVec3> = sp.iter().map(|&p| bump(p, 0.79)).collect();
-    let mut loss = PlanarLoss::new(&cloud.points, &cloud.normals, &PlanarOptions::default())
-        .expect("valid cloud");
     let mut group = c.benchmark_group("planar_loss");
     group.sample_size(10);
-    group.bench_function(format!("value_and_grad/F{}/P50000", st.len()), |b| {
-        b.iter(|| loss.value_and_grad(&sp, &st).expect("valid mesh"))
-    });
+    // The default cap and the previous one (100k), which the default halved.
+    for cap in [PlanarOptions::default().max_samples, 100_000] {
+        let options = PlanarOptions {
+            max_samples: cap,
+            ..PlanarOptions::default()
+        };
+        let mut loss =
+            PlanarLoss::new(&cloud.points, &cloud.normals, &options).expect("valid cloud");
+        group.bench_function(
+            format!("value_and_grad/F{}/P50000/cap{cap}", st.len()),
+            |b| b.iter(|| loss.value_and_grad(&sp, &st).expect("valid mesh")),
+        );
+        println!(
+            "planar loss stats at {} faces, cap {cap}: {:?}",
+            st.len(),
+            loss.last_stats
+        );
+    }
     group.finish();
-    println!(
-        "planar loss stats at {} faces: {:?}",
-        st.len(),
-        loss.last_stats
-    );
 }
 
 criterion_group!(benches, bench_projection, bench_planar_loss);
