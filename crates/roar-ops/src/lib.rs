@@ -6,6 +6,7 @@
 
 pub mod block;
 pub mod collapse_block;
+pub mod data_flips;
 pub mod degenerate;
 pub mod flips;
 pub mod geometry;

@@ -118,6 +118,13 @@ pub struct ReconstructConfig {
     /// aspect ratio over the 14 wild meshes 1.46 with the init at 256 voxels, against 1.26 with
     /// the sweeps at 192; docs/evaluation.md, thirteenth session).
     pub final_smoothing_sweeps: usize,
+    /// Rounds of data-dependent edge flips at exactly N after the smoothing, before the polish
+    /// (0 = off): an edge flips when the quad's other diagonal follows the point cloud's normals
+    /// better (`roar_ops::data_flips`), no face gets worse than `Q = 4` (or the worse old face)
+    /// and no intersection appears. [INF] Not in the paper: the valence flips, the smoothing and
+    /// the final QEM choose the diagonals for the triangles' shapes and the working mesh's
+    /// quadrics, not for the target's normals (docs/evaluation.md, fifteenth session).
+    pub data_flip_rounds: usize,
     /// Every this many iterations, keep a copy of the loop's mesh and its loss (0 = only the
     /// last state). The run finishes from the kept state with the lowest loss (the last one
     /// included) that the untangle block can clear (`run.finished_from_iteration`,
@@ -206,6 +213,7 @@ impl Default for ReconstructConfig {
             split_threshold: 0.02,
             smoothing_interval: 0,
             final_smoothing_sweeps: 3,
+            data_flip_rounds: 5,
             checkpoint_interval: 10,
             step_limiter: true,
             guard_intersections: false,

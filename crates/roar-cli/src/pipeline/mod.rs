@@ -7,7 +7,7 @@
 //! M0 ─QEM─▶ working budget W
 //! loop: loss (λ1·render + λ2·planar) → optimizer step → scheduled blocks
 //! fill to N (edge splits) → untangle → [QEM to 2N → polish, when W > 2N] → QEM to exactly N
-//!   → polish → denormalize
+//!   → smoothing → data flips → polish → denormalize
 //! ```
 //!
 //! A researcher swaps a piece without forking a crate: [`Reconstruction::loss_factory`] builds
@@ -29,6 +29,7 @@ use roar_mesh::spatial::{Aabb, Normalization, self_intersecting_faces};
 use roar_mesh::{EdgeId, Mesh};
 use roar_ops::block::{Block, BlockContext, BlockStats};
 use roar_ops::collapse_block::{FaceCollapse, FaceCollapseOptions};
+use roar_ops::data_flips::{DataFlipOptions, flip_toward_target};
 use roar_ops::degenerate::{DegenerateOptions, collapse_degenerate_faces};
 use roar_ops::flips::FlipOptions;
 use roar_ops::geometry::{DEGENERATE_QUALITY, is_degenerate, triangle_quality};
@@ -163,6 +164,9 @@ pub struct RunStats {
     /// (`final_smoothing_sweeps`; 0 also when the smoothed mesh was dropped because it would
     /// have intersected itself).
     pub final_smoothing_moves: usize,
+    /// Data-dependent flips after the finish's QEMs, summed (`data_flip_rounds`; 0 also when the
+    /// flipped mesh was dropped because it would have intersected itself).
+    pub data_flips: usize,
     /// Loss, terms and faces at every polish iteration (after each of the finish's QEMs).
     pub polish_history: Vec<IterationRecord>,
     /// Whether the last polished mesh was kept (false: it intersected itself, or no polish ran;
@@ -369,6 +373,17 @@ impl Reconstruction {
             if config.iterations > 0 && config.final_smoothing_sweeps > 0 {
                 mesh = smooth_if_clean(mesh, &target.normalization, &config, &mut stats);
                 clock.lap("final_smoothing");
+            }
+
+            if config.iterations > 0 && config.data_flip_rounds > 0 {
+                mesh = flip_toward_cloud_if_clean(
+                    mesh,
+                    &projector,
+                    &target.normalization,
+                    &config,
+                    &mut stats,
+                );
+                clock.lap("data_flips");
             }
 
             // No Move Vertices step at all with `iterations = 0`: that run is the plain init + QEM.
@@ -805,6 +820,35 @@ fn smooth_if_clean(
     }
     stats.final_smoothing_moves += moves;
     smoothed
+}
+
+/// `config.data_flip_rounds` rounds of data-dependent flips toward the normals of the point cloud
+/// (the normal of the cloud point nearest to each sample), kept only if the result is free of
+/// self-intersections in the input's coordinates, as for the smoothing.
+fn flip_toward_cloud_if_clean(
+    mesh: Mesh,
+    cloud: &KnnPlanarProjector,
+    normalization: &Normalization,
+    config: &ReconstructConfig,
+    stats: &mut RunStats,
+) -> Mesh {
+    let target_normal = |p: DVec3| {
+        cloud
+            .nearest(p, 1)
+            .first()
+            .map(|&(i, _)| cloud.normals()[i as usize])
+    };
+    let options = DataFlipOptions {
+        max_rounds: config.data_flip_rounds,
+        ..DataFlipOptions::default()
+    };
+    let mut flipped = mesh.clone();
+    let flips = flip_toward_target(&mut flipped, &target_normal, &options).accepted;
+    if flips == 0 || !clean_in_output_coordinates(&flipped, normalization) {
+        return mesh;
+    }
+    stats.data_flips += flips;
+    flipped
 }
 
 /// Moves every vertex `relative × diagonal` outward along its normal, each move shortened or
