@@ -39,7 +39,7 @@
 
 use crate::block::BlockStats;
 use crate::geometry::triangle_quality;
-use crate::guard::IntersectionGuard;
+use crate::guard::{IntersectionGuard, flip_if_clean};
 use glam::DVec3;
 use rayon::prelude::*;
 use roar_mesh::{EdgeId, Mesh};
@@ -129,21 +129,11 @@ pub fn flip_toward_target(
                 stats.reject(reason, 1);
                 continue;
             }
-            if mesh.can_flip(e).is_err() {
-                stats.reject("topology", 1);
-                continue;
+            if flip_if_clean(mesh, e, &mut guard, &mut stats) {
+                touched[f_l.index()] = true;
+                touched[f_r.index()] = true;
+                flipped += 1;
             }
-            let guard = guard.get_or_insert_with(|| IntersectionGuard::new(mesh));
-            if guard.flip_intersects(mesh, e) {
-                stats.reject("intersection", 1);
-                continue;
-            }
-            guard.mark(f_l);
-            guard.mark(f_r);
-            mesh.flip(e).expect("data flip passed can_flip (invariant)");
-            touched[f_l.index()] = true;
-            touched[f_r.index()] = true;
-            flipped += 1;
         }
         stats.accepted += flipped;
         if flipped == 0 {

@@ -14,6 +14,7 @@
 //! from a short list with their current corners. Every test is
 //! [`crate::intersect::faces_intersect_filtered`], exact behind certified filters.
 
+use crate::block::BlockStats;
 use crate::intersect::faces_intersect_filtered;
 use glam::DVec3;
 use roar_mesh::spatial::{Aabb, TriangleBvh};
@@ -158,6 +159,33 @@ impl IntersectionGuard {
         });
         hit
     }
+}
+
+/// Flips `e` unless the flip is topologically illegal ([`Mesh::can_flip`],
+/// `rejected["topology"]`) or a new face would intersect another face
+/// (`rejected["intersection"]`), keeping `guard` in step. The guard is built at the first flip
+/// that gets this far, so callers with nothing to flip pay nothing for it. Returns whether `e`
+/// was flipped. The sliver and data-dependent flips of a finished mesh share this last step.
+pub fn flip_if_clean(
+    mesh: &mut Mesh,
+    e: EdgeId,
+    guard: &mut Option<IntersectionGuard>,
+    stats: &mut BlockStats,
+) -> bool {
+    if mesh.can_flip(e).is_err() {
+        stats.reject("topology", 1);
+        return false;
+    }
+    let guard = guard.get_or_insert_with(|| IntersectionGuard::new(mesh));
+    if guard.flip_intersects(mesh, e) {
+        stats.reject("intersection", 1);
+        return false;
+    }
+    let h = e.halfedge();
+    guard.mark(mesh.face(h));
+    guard.mark(mesh.face(h.twin()));
+    mesh.flip(e).expect("flip passed can_flip (invariant)");
+    true
 }
 
 #[cfg(test)]

@@ -34,7 +34,7 @@
 
 use crate::block::BlockStats;
 use crate::geometry::{is_degenerate, triangle_normal, triangle_quality};
-use crate::guard::IntersectionGuard;
+use crate::guard::{IntersectionGuard, flip_if_clean};
 use glam::DVec3;
 use roar_mesh::Mesh;
 
@@ -102,20 +102,9 @@ pub fn flip_slivers(mesh: &mut Mesh, options: &SliverOptions) -> BlockStats {
                 stats.reject(reason, 1);
                 continue;
             }
-            if mesh.can_flip(e).is_err() {
-                stats.reject("topology", 1);
-                continue;
+            if flip_if_clean(mesh, e, &mut guard, &mut stats) {
+                flipped += 1;
             }
-            let guard = guard.get_or_insert_with(|| IntersectionGuard::new(mesh));
-            if guard.flip_intersects(mesh, e) {
-                stats.reject("intersection", 1);
-                continue;
-            }
-            guard.mark(mesh.face(h));
-            guard.mark(mesh.face(h.twin()));
-            mesh.flip(e)
-                .expect("sliver flip passed can_flip (invariant)");
-            flipped += 1;
         }
         stats.accepted += flipped;
         if flipped == 0 {

@@ -6,19 +6,12 @@
 
 mod blocks_common;
 
-use blocks_common::random_mesh;
+use blocks_common::{random_mesh, worst_quality};
 use proptest::prelude::*;
+use roar_mesh::DVec3;
 use roar_mesh::shapes::{cube, icosphere};
 use roar_mesh::spatial::count_intersecting_faces;
-use roar_mesh::{DVec3, Mesh};
 use roar_ops::data_flips::{DataFlipOptions, flip_toward_target, target_normal_error};
-use roar_ops::geometry::triangle_quality;
-
-fn worst_quality(mesh: &Mesh) -> f64 {
-    mesh.faces()
-        .map(|f| triangle_quality(mesh.face_vertices(f).map(|v| mesh.position(v))))
-        .fold(1.0, f64::max)
-}
 
 /// The normal of the face of the cube `[-0.5, 0.5]³` nearest to `p` (inside the cube: the axis of
 /// the largest coordinate).

@@ -5,19 +5,13 @@
 
 mod blocks_common;
 
-use blocks_common::random_mesh;
+use blocks_common::{random_mesh, worst_quality};
 use proptest::prelude::*;
 use roar_mesh::shapes::{cube, icosphere};
 use roar_mesh::spatial::count_intersecting_faces;
 use roar_mesh::{FaceId, Mesh};
 use roar_ops::geometry::triangle_quality;
 use roar_ops::slivers::{SliverOptions, flip_slivers};
-
-fn worst_quality(mesh: &Mesh) -> f64 {
-    mesh.faces()
-        .map(|f| triangle_quality(mesh.face_vertices(f).map(|v| mesh.position(v))))
-        .fold(1.0, f64::max)
-}
 
 /// Splits `f` at a point close to the middle of its first edge: a cap (one angle near 180°).
 fn plant_cap(mesh: &mut Mesh, f: FaceId, closeness: f64) {

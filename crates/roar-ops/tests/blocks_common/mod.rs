@@ -88,3 +88,12 @@ pub fn assert_contract(mesh: &Mesh, opt: &Optimizer, euler: i64, what: &str) {
         "{what}: optimizer out of step"
     );
 }
+
+/// The worst aspect ratio `Q = R/(2r)` of `mesh`'s faces (1 for a mesh without faces).
+pub fn worst_quality(mesh: &Mesh) -> f64 {
+    mesh.faces()
+        .map(|f| {
+            roar_ops::geometry::triangle_quality(mesh.face_vertices(f).map(|v| mesh.position(v)))
+        })
+        .fold(1.0, f64::max)
+}
