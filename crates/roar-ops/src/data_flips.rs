@@ -38,7 +38,7 @@
 //! work.
 
 use crate::block::BlockStats;
-use crate::geometry::triangle_quality;
+use crate::geometry::{flip_keeps_orientation, flip_quad, triangle_quality};
 use crate::guard::{IntersectionGuard, flip_if_clean};
 use glam::DVec3;
 use rayon::prelude::*;
@@ -88,9 +88,9 @@ pub type TargetNormal<'a> = &'a (dyn Fn(DVec3) -> Option<DVec3> + Sync);
 /// Flips edges toward the target's normals as the module doc says. Moves no vertex and keeps the
 /// face count; the mesh stays valid and, if it was free of self-intersections, stays so.
 ///
-/// Stats: `candidates` = edges whose flip gains enough (test 1), summed over rounds; `accepted`
-/// = flips; `rejected`: `"normal"`, `"quality"`, `"topology"`, `"intersection"`, `"overlap"`
-/// (a face already flipped in the round).
+/// Stats: `candidates` = edges passing tests 1–3, summed over rounds; `accepted` = flips;
+/// `rejected`: `"normal"`, `"quality"` (every edge failing tests 2–3, each round),
+/// `"topology"`, `"intersection"`, `"overlap"` (a face already flipped in the round).
 pub fn flip_toward_target(
     mesh: &mut Mesh,
     target_normal: TargetNormal,
@@ -101,18 +101,30 @@ pub fn flip_toward_target(
     for _ in 0..options.max_rounds {
         let errors = face_errors(mesh, target_normal);
         let edges: Vec<EdgeId> = mesh.edges().collect();
-        let mut candidates: Vec<(EdgeId, f64)> = edges
+        // Tests 2 and 3 first: they are cheap, and they hold until a face of the edge flips (no
+        // vertex moves), which the overlap test below catches. Only then the target's normals.
+        let outcomes: Vec<Result<Option<f64>, &'static str>> = edges
             .par_iter()
-            .filter_map(|&e| {
+            .map(|&e| {
+                let quad = flip_quad(mesh, e);
+                keeps_shape(quad, options)?;
+                let [pa, pb, pc, pd] = quad;
                 let h = e.halfedge();
                 let old = errors[mesh.face(h).index()] + errors[mesh.face(h.twin()).index()];
-                let [pa, pb, pc, pd] = quad(mesh, e);
                 let new = face_error([pa, pd, pc], target_normal)
                     + face_error([pb, pc, pd], target_normal);
                 let gain = old - new;
-                (gain > options.min_relative_gain * old).then_some((e, gain))
+                Ok((gain > options.min_relative_gain * old).then_some(gain))
             })
             .collect();
+        let mut candidates: Vec<(EdgeId, f64)> = Vec::new();
+        for (&e, outcome) in edges.iter().zip(outcomes) {
+            match outcome {
+                Ok(Some(gain)) => candidates.push((e, gain)),
+                Ok(None) => {}
+                Err(reason) => stats.reject(reason, 1),
+            }
+        }
         stats.candidates += candidates.len();
         candidates.sort_by(|x, y| y.1.total_cmp(&x.1).then(x.0.raw().cmp(&y.0.raw())));
 
@@ -123,10 +135,6 @@ pub fn flip_toward_target(
             let (f_l, f_r) = (mesh.face(h), mesh.face(h.twin()));
             if touched[f_l.index()] || touched[f_r.index()] {
                 stats.reject("overlap", 1);
-                continue;
-            }
-            if let Err(reason) = keeps_shape(quad(mesh, e), options) {
-                stats.reject(reason, 1);
                 continue;
             }
             if flip_if_clean(mesh, e, &mut guard, &mut stats) {
@@ -168,18 +176,6 @@ fn face_errors(mesh: &Mesh, target_normal: TargetNormal) -> Vec<f64> {
     by_id
 }
 
-/// Positions of (a, b, c, d) for edge (a, b) with faces (a, b, c) and (b, a, d).
-fn quad(mesh: &Mesh, e: EdgeId) -> [DVec3; 4] {
-    let h = e.halfedge();
-    [
-        mesh.tail(h),
-        mesh.head(h),
-        mesh.opposite_vertex(h),
-        mesh.opposite_vertex(h.twin()),
-    ]
-    .map(|v| mesh.position(v))
-}
-
 /// `E(f)` of the module doc for the face with corners `p`.
 fn face_error(p: [DVec3; 3], target_normal: TargetNormal) -> f64 {
     let cross = (p[1] - p[0]).cross(p[2] - p[0]);
@@ -203,9 +199,7 @@ fn keeps_shape(
     [pa, pb, pc, pd]: [DVec3; 4],
     options: &DataFlipOptions,
 ) -> Result<(), &'static str> {
-    let n_old = (pb - pa).cross(pc - pa) + (pa - pb).cross(pd - pb);
-    let new = [(pd - pa).cross(pc - pa), (pc - pb).cross(pd - pb)];
-    if !(n_old.dot(new[0]) > 0.0 && n_old.dot(new[1]) > 0.0) {
+    if !flip_keeps_orientation([pa, pb, pc, pd]) {
         return Err("normal");
     }
     let q_old = triangle_quality([pa, pb, pc]).max(triangle_quality([pb, pa, pd]));

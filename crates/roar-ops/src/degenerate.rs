@@ -29,8 +29,8 @@
 //! 4. no reshaped face intersects another face ([`IntersectionGuard`], exact).
 //!
 //! The edges of a degenerate face are tried shortest first, each in both directions. Each
-//! collapse removes two faces; the caller restores the face count (the pipeline splits the
-//! longest edges, which moves no geometry).
+//! collapse removes two faces; the caller restores the face count (the pipeline splits edges
+//! whose halves are not degenerate, longest first, which moves no geometry).
 
 use crate::block::BlockStats;
 use crate::geometry::{DEGENERATE_QUALITY, is_degenerate, triangle_normal, triangle_quality};

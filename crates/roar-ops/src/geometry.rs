@@ -3,7 +3,7 @@
 //! triangle quality Q. Computed once per block call into `Vec`s indexed by element id (slot),
 //! dead slots hold zeros.
 
-use roar_mesh::{DEGENERATE_CROSS, DEGENERATE_NORMAL, DVec3, Mesh, VertexId};
+use roar_mesh::{DEGENERATE_CROSS, DEGENERATE_NORMAL, DVec3, EdgeId, Mesh, VertexId};
 
 /// Unit normal of triangle `(a, b, c)` with the spec's degenerate rule: `|cross| ≤ 1e-9` gives
 /// `(1, 0, 0)` (spec §2.2).
@@ -55,6 +55,26 @@ pub const DEGENERATE_QUALITY: f64 = 100.0;
 /// flips and the degenerate collapses must not trust.
 pub fn is_degenerate(q: f64, limit: f64) -> bool {
     q.is_nan() || q >= limit
+}
+
+/// Positions of `[a, b, c, d]` for edge (a, b) with faces (a, b, c) and (b, a, d): the quad that
+/// flipping the edge re-triangulates into (a, d, c), (b, c, d).
+pub fn flip_quad(mesh: &Mesh, e: EdgeId) -> [DVec3; 4] {
+    let h = e.halfedge();
+    [
+        mesh.tail(h),
+        mesh.head(h),
+        mesh.opposite_vertex(h),
+        mesh.opposite_vertex(h.twin()),
+    ]
+    .map(|v| mesh.position(v))
+}
+
+/// Whether both faces after the flip of [`flip_quad`]'s edge keep the orientation of the pair:
+/// `N_old · n_new > 0` for each, with `N_old = n_L + n_R` unnormalized, so no face turns over.
+pub fn flip_keeps_orientation([pa, pb, pc, pd]: [DVec3; 4]) -> bool {
+    let n_old = (pb - pa).cross(pc - pa) + (pa - pb).cross(pd - pb);
+    n_old.dot((pd - pa).cross(pc - pa)) > 0.0 && n_old.dot((pc - pb).cross(pd - pb)) > 0.0
 }
 
 /// Geometry of one mesh state, indexed by slot id (spec §2.2).

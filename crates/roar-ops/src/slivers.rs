@@ -33,7 +33,9 @@
 //! Edges are visited in id order, rounds repeat until a round flips nothing (or `max_rounds`).
 
 use crate::block::BlockStats;
-use crate::geometry::{is_degenerate, triangle_normal, triangle_quality};
+use crate::geometry::{
+    flip_keeps_orientation, flip_quad, is_degenerate, triangle_normal, triangle_quality,
+};
 use crate::guard::{IntersectionGuard, flip_if_clean};
 use glam::DVec3;
 use roar_mesh::Mesh;
@@ -81,10 +83,7 @@ pub fn flip_slivers(mesh: &mut Mesh, options: &SliverOptions) -> BlockStats {
         let mut flipped = 0;
         let edges: Vec<_> = mesh.edges().collect();
         for e in edges {
-            let h = e.halfedge();
-            let (a, b) = (mesh.tail(h), mesh.head(h));
-            let (c, d) = (mesh.opposite_vertex(h), mesh.opposite_vertex(h.twin()));
-            let [pa, pb, pc, pd] = [a, b, c, d].map(|v| mesh.position(v));
+            let [pa, pb, pc, pd] = flip_quad(mesh, e);
             let q_old = triangle_quality([pa, pb, pc]).max(triangle_quality([pb, pa, pd]));
             // Written so that NaN (a degenerate face) means "no".
             let sliver = q_old > options.max_quality;
@@ -145,8 +144,7 @@ fn keeps_surface(
     if n_l.dot(n_r).abs() < options.min_abs_flatness {
         return Err("dihedral");
     }
-    let n_old = (pb - pa).cross(pc - pa) + (pa - pb).cross(pd - pb);
-    if !(n_old.dot(new[0]) > 0.0 && n_old.dot(new[1]) > 0.0) {
+    if !flip_keeps_orientation([pa, pb, pc, pd]) {
         return Err("normal");
     }
     Ok(())
