@@ -36,6 +36,12 @@ enum Command {
     Decimate(commands::decimate::DecimateArgs),
     /// Write the messy chair-like example soup that the README runs on.
     ExampleSoup(commands::example::ExampleArgs),
+    /// Reconstruct every item of a manifest at one or more budgets, resumably, one child process
+    /// per item; `--shard I/K` (or a SLURM array task) runs every K-th item.
+    Batch(commands::batch::BatchArgs),
+    /// Summarise a batch's output folder in Markdown and JSON: items done, failed and missing,
+    /// failures by reason, metric distributions and the worst items.
+    BatchReport(commands::batch_report::BatchReportArgs),
 }
 
 fn main() -> ExitCode {
@@ -48,6 +54,8 @@ fn main() -> ExitCode {
         Command::Init(args) => commands::init::run(&args),
         Command::Decimate(args) => commands::decimate::run(&args),
         Command::ExampleSoup(args) => commands::example::run(&args),
+        Command::Batch(args) => commands::batch::run(&args),
+        Command::BatchReport(args) => commands::batch_report::run(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

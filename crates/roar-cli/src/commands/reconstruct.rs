@@ -159,7 +159,7 @@ pub fn run(args: &ReconstructArgs) -> anyhow::Result<()> {
 }
 
 /// Defaults, then the TOML file, then the flags.
-fn effective_config(args: &ReconstructArgs) -> anyhow::Result<ReconstructConfig> {
+pub fn effective_config(args: &ReconstructArgs) -> anyhow::Result<ReconstructConfig> {
     let mut config = match &args.config {
         Some(path) => {
             let text = std::fs::read_to_string(path)
