@@ -37,7 +37,7 @@ mod text;
 
 use std::path::Path;
 
-pub use atomic::atomic_write;
+pub use atomic::{atomic_write, check_writable, remove_temporary_files, write_destination};
 pub use error::{IoError, Location};
 pub use image_dump::{write_exr_rgba, write_png_rgba8};
 pub use obj::{read_obj, write_obj};
