@@ -3,6 +3,8 @@
 //! The library half of the `roar` command: one module per subcommand (argument struct plus a
 //! `run` function), and later the reconstruction pipeline that composes the other crates.
 
+pub mod budget;
+pub mod checks;
 pub mod commands;
 pub mod example;
 pub mod input;
