@@ -301,3 +301,32 @@ fn sigterm_stops_a_run_and_leaves_no_temporary_file() {
     assert!(String::from_utf8_lossy(&output.stderr).contains("stopped by signal 15"));
     assert_eq!(files_in(dir.path()), ["ex.obj"]);
 }
+
+#[test]
+fn concave_polygons_are_triangulated_in_their_plane_by_every_reader() {
+    let dir = tempfile::tempdir().unwrap();
+    // An arrowhead listed from a corner beside its notch (a fan would cover the notch), and a
+    // polygon with all corners on one line (no plane: counted).
+    let corners = "2 1 0\n0.5 0 0\n2 -1 0\n0 0 0\n3 0 0\n4 0 0\n5 0 0\n";
+    let obj: String = corners
+        .lines()
+        .map(|l| format!("v {l}\n"))
+        .collect::<String>()
+        + "f 1 2 3 4\nf 4 5 6 7\n";
+    let off = format!("OFF\n7 2 0\n{corners}4 0 1 2 3\n4 3 4 5 6\n");
+    let ply = format!(
+        "ply\nformat ascii 1.0\nelement vertex 7\nproperty float x\nproperty float y\n\
+         property float z\nelement face 2\nproperty list uchar int vertex_indices\nend_header\n\
+         {corners}4 0 1 2 3\n4 3 4 5 6\n"
+    );
+    for (name, text) in [("a.obj", obj), ("a.off", off), ("a.ply", ply)] {
+        let path = dir.path().join(name);
+        std::fs::write(&path, text).unwrap();
+        let soup = roar_io::read_mesh(&path).unwrap();
+        assert_eq!(soup.triangles[..2], [[1, 2, 3], [0, 1, 3]], "{name}");
+        let output = roar(&["info", "--json", s(&path)]);
+        let info: serde_json::Value = serde_json::from_slice(&output.stdout).unwrap();
+        assert_eq!(info["polygons"], 2, "{name}");
+        assert_eq!(info["polygons_unclean"], 1, "{name}");
+    }
+}
