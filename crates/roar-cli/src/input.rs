@@ -58,15 +58,8 @@ pub fn write_mesh(path: &Path, mesh: &Mesh) -> anyhow::Result<()> {
     Ok(())
 }
 
-/// Refuses an odd face budget up front: a closed triangle mesh always has an even face count
-/// (3F = 2E), so the message names the nearest even budgets.
+/// Refuses a face budget no closed mesh can have, up front: odd (3F = 2E) or below the 4 faces
+/// of a tetrahedron; the message names only budgets that work.
 pub fn check_even_budget(faces: usize) -> anyhow::Result<()> {
-    if faces % 2 == 1 {
-        anyhow::bail!(
-            "--faces {faces} is odd, but a closed triangle mesh always has an even face count; use {} or {}",
-            faces - 1,
-            faces + 1
-        );
-    }
-    Ok(())
+    crate::budget::check_budget("--faces", faces, 4).map_err(anyhow::Error::msg)
 }

@@ -4,6 +4,8 @@
 //! `run` function), and later the reconstruction pipeline that composes the other crates.
 
 pub mod batch;
+pub mod budget;
+pub mod checks;
 pub mod commands;
 pub mod example;
 pub mod input;

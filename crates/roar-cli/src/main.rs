@@ -44,8 +44,26 @@ enum Command {
     BatchReport(commands::batch_report::BatchReportArgs),
 }
 
+/// On SIGINT, SIGTERM or SIGHUP: remove the temporary files of the writes in progress (the
+/// destinations stay as they were), then exit with 128 + the signal's number, as a shell would
+/// report it.
+fn clean_up_on_signals() {
+    use signal_hook::consts::{SIGHUP, SIGINT, SIGTERM};
+    let Ok(mut signals) = signal_hook::iterator::Signals::new([SIGINT, SIGTERM, SIGHUP]) else {
+        return;
+    };
+    std::thread::spawn(move || {
+        if let Some(signal) = signals.forever().next() {
+            roar_io::remove_temporary_files();
+            eprintln!("roar: stopped by signal {signal}; unfinished output files removed");
+            std::process::exit(128 + signal);
+        }
+    });
+}
+
 fn main() -> ExitCode {
     let cli = Cli::parse();
+    clean_up_on_signals();
     let result = match cli.command {
         Command::Reconstruct(args) => commands::reconstruct::run(&args),
         Command::Info(args) => commands::info::run(&args),
@@ -60,8 +78,7 @@ fn main() -> ExitCode {
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(error) => {
-            // `{:#}` joins the context chain into one line.
-            eprintln!("roar: error: {error:#}");
+            eprintln!("roar: error: {}", roar_cli::checks::one_line(&error));
             ExitCode::FAILURE
         }
     }

@@ -14,8 +14,10 @@
 //! ## Promises
 //!
 //! * A successful read returns a soup that passes [`TriangleSoup::validate`]: at least one
-//!   triangle, finite coordinates, indices in range. Polygons are fan-triangulated and counted in
-//!   [`TriangleSoup::n_polygons`]; degenerate triangles (repeated indices) are kept. Vertices are
+//!   triangle, finite coordinates, indices in range. Polygons are triangulated in their plane by
+//!   ear clipping (in one place for every reader: convex ones stay fans, concave ones get no
+//!   overlapping triangles) and counted in [`TriangleSoup::n_polygons`], those that could not be
+//!   triangulated cleanly in [`TriangleSoup::n_polygons_unclean`]; degenerate triangles (repeated indices) are kept. Vertices are
 //!   numbered as in the file (OBJ: globally across groups); nothing is welded unless you call
 //!   [`TriangleSoup::welded`].
 //! * Malformed input never panics: it gives an [`IoError`] whose one-line message names the file
@@ -31,18 +33,20 @@ mod image_dump;
 mod obj;
 mod off;
 mod ply;
+mod polygon;
 mod soup;
 mod stl;
 mod text;
 
 use std::path::Path;
 
-pub use atomic::atomic_write;
+pub use atomic::{atomic_write, check_writable, remove_temporary_files, write_destination};
 pub use error::{IoError, Location};
 pub use image_dump::{write_exr_rgba, write_png_rgba8};
 pub use obj::{read_obj, write_obj};
 pub use off::{read_off, write_off};
 pub use ply::{PlyEncoding, read_ply, write_ply};
+pub use polygon::{MAX_EAR_CLIPPING_CORNERS, triangulate_polygon};
 pub use soup::{SoupDefect, TriangleSoup};
 pub use stl::{StlEncoding, read_stl, write_stl};
 

@@ -107,7 +107,7 @@ pub fn read_obj(bytes: &[u8], file: &str) -> Result<TriangleSoup, IoError> {
     if positions.len() > u32::MAX as usize {
         return Err(IoError::in_file(file, "more than 2^32 - 1 vertices"));
     }
-    if fans.triangles.is_empty() {
+    if fans.is_empty() {
         return Err(IoError::in_file(
             file,
             format!(
@@ -116,10 +116,12 @@ pub fn read_obj(bytes: &[u8], file: &str) -> Result<TriangleSoup, IoError> {
             ),
         ));
     }
+    let faces = fans.finish(&positions);
     Ok(TriangleSoup {
         positions,
-        triangles: fans.triangles,
-        n_polygons: fans.n_polygons,
+        triangles: faces.triangles,
+        n_polygons: faces.n_polygons,
+        n_polygons_unclean: faces.n_polygons_unclean,
     })
 }
 

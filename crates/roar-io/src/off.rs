@@ -141,13 +141,15 @@ pub fn read_off(bytes: &[u8], file: &str) -> Result<TriangleSoup, IoError> {
         fans.push_face(&corners);
     }
 
-    if fans.triangles.is_empty() {
+    if fans.is_empty() {
         return Err(IoError::in_file(file, "mesh has no faces"));
     }
+    let faces = fans.finish(&positions);
     Ok(TriangleSoup {
         positions,
-        triangles: fans.triangles,
-        n_polygons: fans.n_polygons,
+        triangles: faces.triangles,
+        n_polygons: faces.n_polygons,
+        n_polygons_unclean: faces.n_polygons_unclean,
     })
 }
 

@@ -15,11 +15,16 @@ pub struct TriangleSoup {
     /// Vertex positions, in file order (f64; STL's f32 values convert exactly).
     pub positions: Vec<DVec3>,
     /// Triangles as 0-based indices into `positions`, in file order; a polygon with `k` corners
-    /// `c0..ck` becomes the fan `(c0, c1, c2), (c0, c2, c3), ...`.
+    /// becomes `k − 2` triangles by ear clipping in its plane (a convex one: the fan
+    /// `(c0, c1, c2), (c0, c2, c3), ...`).
     pub triangles: Vec<[u32; 3]>,
     /// How many faces of the input were polygons with more than 3 corners (0 for soups that were
     /// not read from a file).
     pub n_polygons: usize,
+    /// How many of those polygons could not be triangulated cleanly (no plane, a
+    /// self-intersecting outline, a corner out of range, too many corners) and were
+    /// fan-triangulated, at least in part.
+    pub n_polygons_unclean: usize,
 }
 
 /// Why a soup is not valid (see [`TriangleSoup::validate`]).
@@ -63,6 +68,7 @@ impl TriangleSoup {
             positions,
             triangles,
             n_polygons: 0,
+            n_polygons_unclean: 0,
         }
     }
 
@@ -120,6 +126,7 @@ impl TriangleSoup {
             positions,
             triangles,
             n_polygons: self.n_polygons,
+            n_polygons_unclean: self.n_polygons_unclean,
         };
         (soup, old_to_new)
     }

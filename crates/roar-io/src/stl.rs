@@ -124,6 +124,7 @@ fn read_binary(bytes: &[u8], file: &str) -> Result<TriangleSoup, IoError> {
         positions,
         triangles,
         n_polygons: 0,
+        n_polygons_unclean: 0,
     })
 }
 
@@ -208,13 +209,15 @@ fn read_ascii(bytes: &[u8], file: &str) -> Result<TriangleSoup, IoError> {
             "file ends inside a solid (truncated? missing 'endsolid')",
         ));
     }
-    if fans.triangles.is_empty() {
+    if fans.is_empty() {
         return Err(IoError::in_file(file, "ASCII STL without facets"));
     }
+    let faces = fans.finish(&positions);
     Ok(TriangleSoup {
         positions,
-        triangles: fans.triangles,
-        n_polygons: fans.n_polygons,
+        triangles: faces.triangles,
+        n_polygons: faces.n_polygons,
+        n_polygons_unclean: faces.n_polygons_unclean,
     })
 }
 

@@ -81,25 +81,69 @@ pub(crate) fn parse_point<'a>(
     Ok(DVec3::from_array(c))
 }
 
-/// Collects faces as fans of triangles and counts the polygons among them.
+/// Collects faces and turns them into triangles: triangles as they come, polygons (more than 3
+/// corners) by ear clipping in their own plane once the positions are known
+/// ([`FanBuilder::finish`]; vertices may follow faces in a PLY file).
 #[derive(Debug, Default)]
 pub(crate) struct FanBuilder {
-    /// The triangles so far.
+    /// The triangles so far (polygons not yet included).
+    triangles: Vec<[u32; 3]>,
+    /// Each polygon with the length `triangles` had when it came, to keep the file's order.
+    polygons: Vec<(usize, Vec<u32>)>,
+}
+
+/// The triangles of every face, in file order, and the polygon counts.
+pub(crate) struct Faces {
+    /// The triangles.
     pub triangles: Vec<[u32; 3]>,
-    /// Faces with more than 3 corners so far.
+    /// Faces with more than 3 corners.
     pub n_polygons: usize,
+    /// Polygons that could not be triangulated cleanly (see
+    /// [`crate::polygon::triangulate_polygon`]).
+    pub n_polygons_unclean: usize,
 }
 
 impl FanBuilder {
-    /// Adds a face with `corners.len() >= 3` corners as the fan around its first corner.
+    /// Adds a face with `corners.len() >= 3` corners.
     pub fn push_face(&mut self, corners: &[u32]) {
         debug_assert!(corners.len() >= 3, "callers reject faces with < 3 corners");
         if corners.len() > 3 {
-            self.n_polygons += 1;
+            self.polygons.push((self.triangles.len(), corners.to_vec()));
+        } else {
+            self.triangles.push([corners[0], corners[1], corners[2]]);
         }
-        for k in 1..corners.len().saturating_sub(1) {
-            self.triangles
-                .push([corners[0], corners[k], corners[k + 1]]);
+    }
+
+    /// Whether no face was added.
+    pub fn is_empty(&self) -> bool {
+        self.triangles.is_empty() && self.polygons.is_empty()
+    }
+
+    /// Triangulates the polygons against `positions` and returns every face's triangles.
+    pub fn finish(self, positions: &[DVec3]) -> Faces {
+        let n_polygons = self.polygons.len();
+        if n_polygons == 0 {
+            return Faces {
+                triangles: self.triangles,
+                n_polygons,
+                n_polygons_unclean: 0,
+            };
+        }
+        let mut triangles = Vec::with_capacity(self.triangles.len() + 2 * n_polygons);
+        let mut n_polygons_unclean = 0;
+        let mut copied = 0;
+        for (at, corners) in &self.polygons {
+            triangles.extend_from_slice(&self.triangles[copied..*at]);
+            copied = *at;
+            if !crate::polygon::triangulate_polygon(positions, corners, &mut triangles) {
+                n_polygons_unclean += 1;
+            }
+        }
+        triangles.extend_from_slice(&self.triangles[copied..]);
+        Faces {
+            triangles,
+            n_polygons,
+            n_polygons_unclean,
         }
     }
 }
@@ -126,14 +170,41 @@ mod tests {
     }
 
     #[test]
-    fn fan_triangulates_polygons_and_counts_them() {
+    fn polygons_are_triangulated_in_file_order_and_counted() {
+        // A convex pentagon (a fan), a triangle, a concave quad (an arrowhead with its notch at
+        // corner 10, listed from corner 9).
+        let mut positions: Vec<DVec3> = (0..8)
+            .map(|k| {
+                let t = k as f64 / 5.0 * std::f64::consts::TAU;
+                DVec3::new(t.cos(), t.sin(), 0.0)
+            })
+            .collect();
+        positions.extend([
+            DVec3::new(0.0, 0.0, 0.0),
+            DVec3::new(2.0, 1.0, 0.0),
+            DVec3::new(0.5, 0.0, 0.0),
+            DVec3::new(2.0, -1.0, 0.0),
+        ]);
         let mut f = FanBuilder::default();
         f.push_face(&[0, 1, 2]);
         f.push_face(&[3, 4, 5, 6, 7]);
-        assert_eq!(f.n_polygons, 1);
+        f.push_face(&[0, 2, 1]);
+        f.push_face(&[9, 10, 11, 8]);
+        let faces = f.finish(&positions);
+        assert_eq!(faces.n_polygons, 2);
+        assert_eq!(faces.n_polygons_unclean, 0);
         assert_eq!(
-            f.triangles,
-            vec![[0, 1, 2], [3, 4, 5], [3, 5, 6], [3, 6, 7]]
+            faces.triangles,
+            vec![
+                [0, 1, 2],
+                [3, 4, 5],
+                [3, 5, 6],
+                [3, 6, 7],
+                [0, 2, 1],
+                // The fan's (9, 10, 11) would cover the notch, outside the polygon.
+                [10, 11, 8],
+                [9, 10, 8],
+            ]
         );
     }
 

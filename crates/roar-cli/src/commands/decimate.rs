@@ -7,6 +7,8 @@ use std::path::PathBuf;
 use clap::Args;
 use roar_ops::qem::{DecimateOptions, decimate_in_parallel};
 
+use crate::budget::{check_budget, min_reachable_budget, parse_faces};
+use crate::checks::check_paths;
 use crate::input::{read_closed_mesh, write_mesh};
 
 /// Arguments of `roar decimate`.
@@ -17,24 +19,43 @@ pub struct DecimateArgs {
     /// Where to write the result (format by extension).
     #[arg(short, long)]
     pub output: PathBuf,
-    /// The exact face count to reach (even).
-    #[arg(long)]
+    /// The exact face count to reach (even, at most the input's).
+    #[arg(long, allow_negative_numbers = true, value_parser = parse_faces)]
     pub faces: usize,
-    /// When the vetoes block the budget, write the closest mesh instead of failing.
+    /// When the vetoes block the budget, write the closest mesh instead of failing (the exit
+    /// status is 0 and the message says how close it got).
     #[arg(long)]
     pub best_effort: bool,
 }
 
 /// Runs `roar decimate`.
+///
+/// Errors before any work: input and output the same file, an output that cannot be written, a
+/// budget that is odd, below what the input's pieces and genera allow, or above the input's
+/// face count (decimation only removes faces). After the decimation: the budget was not reached
+/// (unless `--best-effort`), naming how close it got and why.
 pub fn run(args: &DecimateArgs) -> anyhow::Result<()> {
+    check_paths(&[("INPUT", &args.input)], &[("-o", &args.output)])?;
     let mut mesh = read_closed_mesh(&args.input)?;
+    let minimum = min_reachable_budget(&mesh.component_genera());
+    check_budget("--faces", args.faces, minimum).map_err(anyhow::Error::msg)?;
+    if args.faces > mesh.n_faces() {
+        anyhow::bail!(
+            "--faces {} is above the {} faces of {}: decimation only removes faces \
+             (`roar reconstruct` refines a mesh to any budget)",
+            args.faces,
+            mesh.n_faces(),
+            args.input.display()
+        );
+    }
     let options = DecimateOptions {
         best_effort: args.best_effort,
         ..DecimateOptions::default()
     };
     let stats = decimate_in_parallel(&mut mesh, args.faces, &options)?;
+    let reached = mesh.n_faces() == args.faces;
     write_mesh(&args.output, &mesh)?;
-    if stats.reached_target {
+    if reached {
         eprintln!(
             "wrote {} ({} faces, from {})",
             args.output.display(),

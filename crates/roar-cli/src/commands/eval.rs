@@ -17,7 +17,7 @@ pub struct EvalArgs {
     /// Print the JSON report instead of text.
     #[arg(long)]
     pub json: bool,
-    /// Area-weighted samples per side for the fidelity metrics.
+    /// Area-weighted samples per side for the fidelity metrics (at least 1 with `--ref`).
     #[arg(long, default_value_t = ChamferOptions::default().samples)]
     pub samples: usize,
     /// Seed of the sampling.
@@ -25,8 +25,15 @@ pub struct EvalArgs {
     pub seed: u64,
 }
 
-/// Runs `roar eval`.
+/// Runs `roar eval`. With `--ref`, the fidelity section is never dropped silently: `--samples 0`
+/// is refused up front, and a mesh or reference without area (nothing to sample) is an error
+/// that says which.
 pub fn run(args: &EvalArgs) -> anyhow::Result<()> {
+    if args.reference.is_some() && args.samples == 0 {
+        anyhow::bail!(
+            "--samples 0 with --ref: the fidelity metrics need at least 1 sample per side"
+        );
+    }
     let mesh = roar_io::read_mesh(&args.mesh)?;
     let reference = args
         .reference
@@ -48,6 +55,25 @@ pub fn run(args: &EvalArgs) -> anyhow::Result<()> {
             .map(|r| (r.positions.as_slice(), r.triangles.as_slice())),
         &options,
     )?;
+    if let (Some(reference_path), Some(reference)) = (&args.reference, &reference)
+        && report.fidelity.is_none()
+    {
+        let zero = |soup: &roar_io::TriangleSoup| {
+            roar_mesh::spatial::sample_surface(&soup.positions, &soup.triangles, 1, 0)
+                .points
+                .is_empty()
+        };
+        let which = if zero(reference) {
+            reference_path
+        } else {
+            &args.mesh
+        };
+        anyhow::bail!(
+            "{}: the surface has zero area, so there is nothing to sample for the fidelity \
+             metrics (Chamfer, Hausdorff, normal cosine)",
+            which.display()
+        );
+    }
     if args.json {
         println!("{}", serde_json::to_string_pretty(&report)?);
     } else {

@@ -23,8 +23,13 @@ pub struct InfoArgs {
 pub struct Info {
     /// Vertices as stored in the file.
     pub vertices: usize,
-    /// Triangles after fan triangulation of polygons.
+    /// Triangles after polygons were triangulated (ear clipping in each polygon's plane).
     pub faces: usize,
+    /// Faces of the file with more than 3 corners.
+    pub polygons: usize,
+    /// Polygons that could not be triangulated cleanly (no plane, a self-intersecting outline,
+    /// too many corners): fan-triangulated, at least in part, so their triangles may overlap.
+    pub polygons_unclean: usize,
     /// Distinct vertex positions (bit-identical positions welded).
     pub vertices_welded: usize,
     /// Axis-aligned bounding box of the referenced vertices, `[min, max]`.
@@ -64,6 +69,8 @@ pub fn info(path: &std::path::Path) -> anyhow::Result<Info> {
     let mut info = Info {
         vertices: soup.positions.len(),
         faces: soup.triangles.len(),
+        polygons: soup.n_polygons,
+        polygons_unclean: soup.n_polygons_unclean,
         vertices_welded: welded.positions.len(),
         bbox,
         closed_manifold: false,
@@ -97,6 +104,12 @@ fn format_text(path: &std::path::Path, info: &Info) -> String {
         hi[1],
         hi[2],
     );
+    if info.polygons > 0 {
+        text.push_str(&format!(
+            "  polygons  {} triangulated, {} not cleanly (no plane or a self-intersecting outline)\n",
+            info.polygons, info.polygons_unclean
+        ));
+    }
     match (&info.not_manifold_because, info.genus, info.components) {
         (None, Some(genus), Some(components)) => text.push_str(&format!(
             "  closed 2-manifold: yes, genus {genus}, {components} component(s)\n"

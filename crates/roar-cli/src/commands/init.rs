@@ -29,6 +29,7 @@ pub struct InitArgs {
 /// Runs `roar init`.
 pub fn run(args: &InitArgs) -> anyhow::Result<()> {
     check_even_budget(args.faces)?;
+    crate::checks::check_paths(&[("INPUT", &args.input)], &[("-o", &args.output)])?;
     let soup = roar_io::read_mesh(&args.input)?;
     let (positions, triangles) = welded_referenced(&soup);
     let options = InitialMeshOptions {

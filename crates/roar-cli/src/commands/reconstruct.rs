@@ -2,8 +2,9 @@
 //! closed, oriented 2-manifold with exactly N faces and no self-intersections, plus a JSON report
 //! (input and output metrics, stage timings, the effective config and the seed).
 
+use std::io::IsTerminal;
 use std::path::PathBuf;
-use std::time::Instant;
+use std::time::{Duration, Instant};
 
 use anyhow::Context;
 use clap::Args;
@@ -11,6 +12,7 @@ use indicatif::{ProgressBar, ProgressStyle};
 use roar_eval::{EvalOptions, Report};
 use serde::Serialize;
 
+use crate::checks::check_paths;
 use crate::pipeline::{InitKind, Progress, ReconstructConfig, Reconstruction, RunStats};
 
 /// Arguments of `roar reconstruct`.
@@ -21,8 +23,8 @@ pub struct ReconstructArgs {
     /// Where to write the result (format by extension).
     #[arg(short, long)]
     pub output: Option<PathBuf>,
-    /// Exact face count of the result (even).
-    #[arg(long)]
+    /// Exact face count of the result (even, at least 4 per piece).
+    #[arg(long, allow_negative_numbers = true, value_parser = crate::budget::parse_faces)]
     pub faces: Option<usize>,
     /// TOML file overriding any configuration key (see `--print-config`).
     #[arg(long)]
@@ -33,7 +35,7 @@ pub struct ReconstructArgs {
     /// Move Vertices iterations.
     #[arg(long)]
     pub iterations: Option<usize>,
-    /// Voxels along the longest axis of the watertight init.
+    /// Voxels along the longest axis of the watertight init (not with `--init sphere`).
     #[arg(long)]
     pub resolution: Option<usize>,
     /// Seed of every random choice.
@@ -51,6 +53,9 @@ pub struct ReconstructArgs {
     /// No progress bar and no report on stdout (for scripts).
     #[arg(long, short)]
     pub quiet: bool,
+    /// Run even when the estimated memory of the budget exceeds what this machine has.
+    #[arg(long)]
+    pub force: bool,
 }
 
 /// The JSON report of one reconstruction.
@@ -87,12 +92,20 @@ pub fn run(args: &ReconstructArgs) -> anyhow::Result<()> {
         .context("an INPUT file is required (or --print-config)")?;
     let output = args.output.as_ref().context("-o OUTPUT is required")?;
     config.validate().map_err(|e| anyhow::anyhow!(e))?;
+    let mut inputs = vec![("INPUT", input.as_path())];
+    inputs.extend(args.config.as_deref().map(|c| ("--config", c)));
+    let mut outputs = vec![("-o", output.as_path())];
+    outputs.extend(args.report.as_deref().map(|r| ("--report", r)));
+    check_paths(&inputs, &outputs)?;
     roar_io::MeshFormat::from_path(output)?;
     let started = Instant::now();
     let soup = roar_io::read_mesh(input)?;
+    check_resources(&config, soup.triangles.len(), args.force)?;
 
     let bar = progress_bar(args.quiet, config.iterations);
+    let mut lines = ProgressLines::new(args.quiet || bar.is_some());
     let mut on_progress = |p: &Progress| {
+        lines.report(p);
         if let Some(bar) = &bar {
             bar.set_position(p.iteration as u64);
             bar.set_message(if p.loss.is_finite() {
@@ -184,6 +197,11 @@ pub fn effective_config(args: &ReconstructArgs) -> anyhow::Result<ReconstructCon
         config.iterations = iterations;
     }
     if let Some(resolution) = args.resolution {
+        if config.init == InitKind::Sphere {
+            anyhow::bail!(
+                "--resolution sets the watertight init's voxels; it has no effect with --init sphere"
+            );
+        }
         config.init_resolution = resolution;
     }
     if let Some(seed) = args.seed {
@@ -195,8 +213,9 @@ pub fn effective_config(args: &ReconstructArgs) -> anyhow::Result<ReconstructCon
     Ok(config)
 }
 
+/// A progress bar when stderr is a terminal and not `--quiet`.
 fn progress_bar(quiet: bool, iterations: usize) -> Option<ProgressBar> {
-    if quiet {
+    if quiet || !std::io::stderr().is_terminal() {
         return None;
     }
     let bar = ProgressBar::new(iterations as u64);
@@ -209,3 +228,67 @@ fn progress_bar(quiet: bool, iterations: usize) -> Option<ProgressBar> {
     );
     Some(bar)
 }
+
+/// Plain progress lines on stderr, at most one every [`ProgressLines::EVERY`], for when there is
+/// no progress bar (stderr is a file or a pipe): a long run is never silent.
+struct ProgressLines {
+    started: Instant,
+    last: Option<Instant>,
+    off: bool,
+}
+
+impl ProgressLines {
+    const EVERY: Duration = Duration::from_secs(10);
+
+    fn new(off: bool) -> Self {
+        Self {
+            started: Instant::now(),
+            last: None,
+            off,
+        }
+    }
+
+    fn report(&mut self, p: &Progress) {
+        let now = Instant::now();
+        let due = self.last.is_none_or(|last| now - last >= Self::EVERY);
+        if self.off || !due {
+            return;
+        }
+        self.last = Some(now);
+        eprintln!(
+            "roar: {:6.1} s  {:<10} iteration {}/{}  faces {}",
+            (now - self.started).as_secs_f64(),
+            p.stage,
+            p.iteration,
+            p.iterations,
+            p.faces
+        );
+    }
+}
+
+/// Refuses, before the run, a budget whose estimated peak memory
+/// ([`crate::budget::estimated_peak_bytes`]) exceeds the memory this machine has available
+/// (`MemAvailable` of `/proc/meminfo`), unless `force`.
+fn check_resources(
+    config: &ReconstructConfig,
+    input_faces: usize,
+    force: bool,
+) -> anyhow::Result<()> {
+    let needed = crate::budget::estimated_peak_bytes(config, input_faces);
+    let Some(available) = crate::budget::available_memory_bytes() else {
+        return Ok(());
+    };
+    if needed > available && !force {
+        anyhow::bail!(
+            "--faces {} needs about {:.1} GiB (working budget {} faces), but {:.1} GiB are \
+             available; use a smaller budget, or --force to try anyway",
+            config.faces,
+            needed as f64 / GIB,
+            config.working_budget(),
+            available as f64 / GIB
+        );
+    }
+    Ok(())
+}
+
+const GIB: f64 = (1u64 << 30) as f64;

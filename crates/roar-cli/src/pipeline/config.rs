@@ -236,55 +236,173 @@ impl ReconstructConfig {
         w + w % 2
     }
 
-    /// Checks ranges a run depends on, with one-line messages.
+    /// Checks every numeric field against its range ([`ReconstructConfig::field_ranges`]) and
+    /// the rules between fields, before any work; the one-line error names the field, its value
+    /// and what is allowed. NaN and infinities are outside every range.
     pub fn validate(&self) -> Result<(), String> {
-        if self.faces % 2 == 1 {
-            return Err(format!(
-                "faces = {} is odd, but a closed triangle mesh always has an even face count; use {} or {}",
-                self.faces,
-                self.faces - 1,
-                self.faces + 1
-            ));
+        crate::budget::check_budget("faces =", self.faces, 4)?;
+        for (range, value) in self.field_ranges() {
+            if !range.allows(value) {
+                return Err(format!(
+                    "config: {} = {} is out of range: allowed {}",
+                    range.name,
+                    value,
+                    range.describe()
+                ));
+            }
         }
-        if self.faces < 4 {
+        if self.working_budget_min > self.working_budget_max {
             return Err(format!(
-                "faces = {} is below the 4 faces of a tetrahedron",
-                self.faces
-            ));
-        }
-        if self.views_per_axis == 0 || self.render_resolution == 0 {
-            return Err("views_per_axis and render_resolution must be positive".into());
-        }
-        if !(self.learning_rate > 0.0 && self.learning_rate.is_finite()) {
-            return Err(format!(
-                "learning_rate = {} must be positive",
-                self.learning_rate
-            ));
-        }
-        if !(self.sliver_quality == 0.0 || self.sliver_quality >= 1.0) {
-            return Err(format!(
-                "sliver_quality = {} must be 0 (off) or at least 1",
-                self.sliver_quality
-            ));
-        }
-        if !(self.sheet_offset >= 0.0 && self.sheet_offset < 0.1) {
-            return Err(format!(
-                "sheet_offset = {} must be at least 0 and below 0.1",
-                self.sheet_offset
-            ));
-        }
-        if !(self.final_qem_offset >= 0.0 && self.final_qem_offset < 0.1) {
-            return Err(format!(
-                "final_qem_offset = {} must be at least 0 and below 0.1",
-                self.final_qem_offset
-            ));
-        }
-        if self.init_resolution < 8 {
-            return Err(format!(
-                "init_resolution = {} is below 8",
-                self.init_resolution
+                "config: working_budget_min = {} is above working_budget_max = {}",
+                self.working_budget_min, self.working_budget_max
             ));
         }
         Ok(())
+    }
+
+    /// Every numeric field with its allowed range and its current value, in declaration order.
+    /// The ranges are wide: they refuse what cannot mean anything (NaN, infinities, negative
+    /// weights, zero samples, huge values that would exhaust memory or time), not what is merely
+    /// unusual. `0 (off)` marks the fields where 0 switches a feature off, as their docs say.
+    pub fn field_ranges(&self) -> Vec<(FieldRange, f64)> {
+        let r = FieldRange::new;
+        let off = FieldRange::zero_or;
+        vec![
+            (r("faces", 4.0, 1e9), self.faces as f64),
+            (r("seed", 0.0, u64::MAX as f64), self.seed as f64),
+            (r("iterations", 0.0, 1e5), self.iterations as f64),
+            (
+                r("init_resolution", 8.0, 1024.0),
+                self.init_resolution as f64,
+            ),
+            (r("init_max_faces", 4.0, 1e7), self.init_max_faces as f64),
+            (r("sphere_level", 0.0, 8.0), f64::from(self.sphere_level)),
+            (
+                r("working_budget_factor", 1.0, 100.0),
+                self.working_budget_factor as f64,
+            ),
+            (
+                r("working_budget_min", 4.0, 1e7),
+                self.working_budget_min as f64,
+            ),
+            (
+                r("working_budget_max", 4.0, 1e7),
+                self.working_budget_max as f64,
+            ),
+            (r("views_per_axis", 1.0, 32.0), self.views_per_axis as f64),
+            (
+                r("render_resolution", 16.0, 4096.0),
+                f64::from(self.render_resolution),
+            ),
+            (r("twin_ratio", 1.0, 1e6), self.twin_ratio),
+            (r("render_weight", 0.0, 1e6), self.render_weight),
+            (r("planar_weight", 0.0, 1e6), self.planar_weight),
+            (r("planar_scale", 0.0, 1e9), self.planar_scale),
+            (
+                r("planar_max_samples", 1.0, 1e8),
+                self.planar_max_samples as f64,
+            ),
+            (
+                r("planar_neighbours", 1.0, 100.0),
+                self.planar_neighbours as f64,
+            ),
+            (
+                r("point_cloud_samples", 100.0, 5e7),
+                self.point_cloud_samples as f64,
+            ),
+            (r("winding_threshold", 1e-6, 1.0), self.winding_threshold),
+            (r("sheet_offset", 0.0, 0.1), self.sheet_offset),
+            (
+                r("sharp_edge_samples", 0.0, 5e7),
+                self.sharp_edge_samples as f64,
+            ),
+            (r("learning_rate", 1e-9, 10.0), self.learning_rate),
+            (r("laplacian_weight", 0.0, 1e3), self.laplacian_weight),
+            (
+                r("collapse_interval", 0.0, 1e5),
+                self.collapse_interval as f64,
+            ),
+            (r("collapse_fold_slack", 0.0, 1.0), self.collapse_fold_slack),
+            (
+                r("collapse_min_normal_size", 0.0, 1.0),
+                self.collapse_min_normal_size,
+            ),
+            (r("split_interval", 0.0, 1e5), self.split_interval as f64),
+            (r("split_threshold", 0.0, 1e3), self.split_threshold),
+            (
+                r("smoothing_interval", 0.0, 1e5),
+                self.smoothing_interval as f64,
+            ),
+            (
+                r("final_smoothing_sweeps", 0.0, 1e3),
+                self.final_smoothing_sweeps as f64,
+            ),
+            (
+                r("data_flip_rounds", 0.0, 1e3),
+                self.data_flip_rounds as f64,
+            ),
+            (
+                r("checkpoint_interval", 0.0, 1e5),
+                self.checkpoint_interval as f64,
+            ),
+            (r("untangle_margin", 0.0, 0.01), self.untangle_margin),
+            (r("final_qem_offset", 0.0, 0.1), self.final_qem_offset),
+            (
+                r("polish_iterations", 0.0, 1e5),
+                self.polish_iterations as f64,
+            ),
+            (off("sliver_quality", 1.0, 1e6), self.sliver_quality),
+        ]
+    }
+}
+
+/// The values a numeric configuration field may take: `min ..= max`, and 0 as well where 0
+/// switches the feature off. Named by its TOML key, so a message points at the line to fix.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FieldRange {
+    /// The field's TOML key.
+    pub name: &'static str,
+    /// Smallest allowed value (besides 0 when `zero_is_off`).
+    pub min: f64,
+    /// Largest allowed value.
+    pub max: f64,
+    /// Whether 0 is allowed too, meaning "off".
+    pub zero_is_off: bool,
+}
+
+impl FieldRange {
+    /// `min ..= max`.
+    pub const fn new(name: &'static str, min: f64, max: f64) -> Self {
+        Self {
+            name,
+            min,
+            max,
+            zero_is_off: false,
+        }
+    }
+
+    /// 0 (off) or `min ..= max`.
+    pub const fn zero_or(name: &'static str, min: f64, max: f64) -> Self {
+        Self {
+            name,
+            min,
+            max,
+            zero_is_off: true,
+        }
+    }
+
+    /// Whether `value` is allowed (never NaN or an infinity).
+    pub fn allows(&self, value: f64) -> bool {
+        (self.zero_is_off && value == 0.0) || (value >= self.min && value <= self.max)
+    }
+
+    /// The range in words, for messages: `0 (off) or 1 to 1000000`.
+    pub fn describe(&self) -> String {
+        let span = format!("{} to {}", self.min, self.max);
+        if self.zero_is_off {
+            format!("0 (off) or {span}")
+        } else {
+            span
+        }
     }
 }

@@ -1,0 +1,127 @@
+//! Face budgets a user may ask for, known before any work: a closed triangle mesh has an even face
+//! count (3F = 2E), and each closed piece needs at least the faces of the smallest triangulation
+//! of its genus (4 for a sphere, 14 for a torus: `roar_ops::qem::minimum_faces_for_genus`).
+//! Every operator keeps the pieces and their genera, so this is the smallest budget a run can
+//! reach; the one place to change when the finish learns to remove handles.
+
+use roar_ops::qem::minimum_faces_for_genus;
+
+/// The smallest face count a closed mesh with pieces of these genera can be decimated to while
+/// keeping its topology: the sum of each piece's minimum (`2(V − 2 + 2g)` with Heawood's vertex
+/// bound). 0 pieces → 0.
+pub fn min_reachable_budget(genera: &[usize]) -> usize {
+    genera.iter().copied().map(minimum_faces_for_genus).sum()
+}
+
+/// Checks `faces` against the smallest budget `minimum` (even, ≥ 4) before any work; the error
+/// suggests only budgets that work: the nearest even counts at or above `minimum`.
+pub fn check_budget(flag: &str, faces: usize, minimum: usize) -> Result<(), String> {
+    let minimum = minimum.max(4);
+    if faces >= minimum && faces.is_multiple_of(2) {
+        return Ok(());
+    }
+    let why = if faces < minimum {
+        format!("is below the smallest reachable budget, {minimum} faces")
+    } else {
+        "is odd, but a closed triangle mesh always has an even face count".to_string()
+    };
+    let below = faces - faces % 2;
+    let advice = if below >= minimum && below != faces {
+        format!("use {below} or {}", below + 2)
+    } else {
+        format!("use {}", minimum.max(faces + faces % 2))
+    };
+    Err(format!("{flag} {faces} {why}; {advice}"))
+}
+
+/// A clap value parser for `--faces`: a non-negative whole number, with a message that says so
+/// for `-10` or `ten` (clap would otherwise read `-10` as the flags `-1 -0`).
+pub fn parse_faces(text: &str) -> Result<usize, String> {
+    text.trim()
+        .parse::<usize>()
+        .map_err(|_| format!("{text:?} is not a face count (a positive even whole number)"))
+}
+
+/// Bytes a reconstruction is expected to need at its peak, from the sizes that drive it: the
+/// working budget `W` (the loop's mesh, its BVH and optimizer state, the renders' per-face
+/// buffers), the input's faces (the cleaned target and its BVH) and the fixed part (the 36
+/// target renders, the point cloud and its k-d tree). A rough linear model: the fixed and
+/// per-pixel parts match the measured peak of a short run (docs/reliability.md, "Memory"); the
+/// per-face part is a deliberately high guess. It is meant to tell a budget that fits from one
+/// that cannot, not to predict a figure.
+pub fn estimated_peak_bytes(
+    config: &crate::pipeline::ReconstructConfig,
+    input_faces: usize,
+) -> u64 {
+    let working = config.working_budget() as u64;
+    let pixels = (config.views_per_axis * config.views_per_axis) as u64
+        * u64::from(config.render_resolution).pow(2);
+    FIXED_BYTES
+        + BYTES_PER_WORKING_FACE * working
+        + BYTES_PER_INPUT_FACE * input_faces as u64
+        + BYTES_PER_PIXEL * pixels
+        + BYTES_PER_SAMPLE * config.point_cloud_samples as u64
+}
+
+/// Memory the kernel says is available (`MemAvailable` in `/proc/meminfo`), if it says.
+pub fn available_memory_bytes() -> Option<u64> {
+    let text = std::fs::read_to_string("/proc/meminfo").ok()?;
+    let line = text.lines().find(|l| l.starts_with("MemAvailable:"))?;
+    let kib: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kib * 1024)
+}
+
+const FIXED_BYTES: u64 = 64 << 20;
+const BYTES_PER_WORKING_FACE: u64 = 2048;
+const BYTES_PER_INPUT_FACE: u64 = 512;
+const BYTES_PER_PIXEL: u64 = 40;
+const BYTES_PER_SAMPLE: u64 = 256;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn smallest_budgets_of_spheres_tori_and_several_pieces() {
+        assert_eq!(min_reachable_budget(&[0]), 4);
+        assert_eq!(min_reachable_budget(&[1]), 14);
+        assert_eq!(min_reachable_budget(&[0, 0]), 8);
+        assert_eq!(min_reachable_budget(&[0, 1]), 18);
+        assert_eq!(min_reachable_budget(&[]), 0);
+    }
+
+    #[test]
+    fn advice_names_only_budgets_that_work() {
+        for (faces, minimum, advice) in [
+            (1, 4, "use 4"),
+            (3, 4, "use 4"),
+            (0, 4, "use 4"),
+            (5, 4, "use 4 or 6"),
+            (4, 8, "use 8"),
+            (9, 8, "use 8 or 10"),
+            (13, 14, "use 14"),
+        ] {
+            let message = check_budget("--faces", faces, minimum).unwrap_err();
+            assert!(message.ends_with(advice), "{faces}: {message}");
+            let suggested: Vec<usize> = message
+                .rsplit("use ")
+                .next()
+                .unwrap()
+                .split(" or ")
+                .map(|n| n.parse().unwrap())
+                .collect();
+            for s in suggested {
+                check_budget("--faces", s, minimum).unwrap();
+            }
+        }
+        check_budget("--faces", 4, 4).unwrap();
+        check_budget("--faces", 5000, 8).unwrap();
+    }
+
+    #[test]
+    fn parse_faces_explains_negative_numbers() {
+        assert_eq!(parse_faces("5000"), Ok(5000));
+        assert!(parse_faces("-10").unwrap_err().contains("not a face count"));
+        assert!(parse_faces("ten").is_err());
+    }
+}
