@@ -330,3 +330,32 @@ fn concave_polygons_are_triangulated_in_their_plane_by_every_reader() {
         assert_eq!(info["polygons_unclean"], 1, "{name}");
     }
 }
+
+#[test]
+fn a_run_writes_its_mesh_and_report_together_and_nothing_else() {
+    let (dir, soup) = example_folder();
+    let out = dir.path().join("out.obj");
+    let report = dir.path().join("report.json");
+    let output = roar(&[
+        "reconstruct",
+        s(&soup),
+        "-o",
+        s(&out),
+        "--report",
+        s(&report),
+        "--faces",
+        "500",
+        "--iterations",
+        "0",
+        "-q",
+    ]);
+    assert!(
+        output.status.success(),
+        "{}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    assert_eq!(files_in(dir.path()), ["ex.obj", "out.obj", "report.json"]);
+    let json: serde_json::Value = serde_json::from_slice(&std::fs::read(&report).unwrap()).unwrap();
+    assert_eq!(json["output"], s(&out));
+    assert_eq!(roar_io::read_mesh(&out).unwrap().triangles.len(), 500);
+}

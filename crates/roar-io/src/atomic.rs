@@ -145,6 +145,54 @@ pub fn atomic_write(
     path: &Path,
     write: impl FnOnce(&mut dyn Write) -> std::io::Result<()>,
 ) -> Result<(), IoError> {
+    stage(path, write)?.commit()
+}
+
+/// Writes several files all or nothing as far as the file system allows: every file's content is
+/// written to its temporary file and synced first (a full disk or any other failure then leaves
+/// every destination untouched); only then are they renamed into place, in order. Each file as
+/// in [`atomic_write`].
+pub fn atomic_write_all(files: Vec<(&Path, FileContent<'_>)>) -> Result<(), IoError> {
+    let mut staged = Vec::with_capacity(files.len());
+    for (path, write) in files {
+        staged.push(stage(path, write)?);
+    }
+    staged.into_iter().try_for_each(Staged::commit)
+}
+
+/// What [`atomic_write_all`] writes into one file.
+pub type FileContent<'a> = Box<dyn FnOnce(&mut dyn Write) -> std::io::Result<()> + 'a>;
+
+/// A temporary file holding a destination's complete new content, synced, not yet renamed.
+struct Staged {
+    path: PathBuf,
+    target: PathBuf,
+    temp: tempfile::NamedTempFile,
+    _registered: InFlight,
+}
+
+impl Staged {
+    /// Renames the temporary file over the destination.
+    fn commit(self) -> Result<(), IoError> {
+        let Staged {
+            path,
+            target,
+            temp,
+            _registered,
+        } = self;
+        temp.persist(&target).map_err(|e| IoError::Os {
+            path,
+            source: plain(e.error),
+        })?;
+        Ok(())
+    }
+}
+
+/// Writes `write`'s content to a temporary file beside `path`'s destination and syncs it.
+fn stage(
+    path: &Path,
+    write: impl FnOnce(&mut dyn Write) -> std::io::Result<()>,
+) -> Result<Staged, IoError> {
     let os = |source: std::io::Error| IoError::Os {
         path: path.to_path_buf(),
         source: plain(source),
@@ -166,7 +214,7 @@ pub fn atomic_write(
         .permissions(Permissions::from_mode(0o666))
         .tempfile_in(folder)
         .map_err(os)?;
-    let _registered = InFlight::new(temp.path());
+    let registered = InFlight::new(temp.path());
     if let Some(mode) = existing_mode {
         temp.as_file()
             .set_permissions(Permissions::from_mode(mode))
@@ -176,8 +224,12 @@ pub fn atomic_write(
     write(&mut out).map_err(os)?;
     let temp = out.into_inner().map_err(|e| os(e.into_error()))?;
     temp.as_file().sync_all().map_err(os)?;
-    temp.persist(&target).map_err(|e| os(e.error))?;
-    Ok(())
+    Ok(Staged {
+        path: path.to_path_buf(),
+        target,
+        temp,
+        _registered: registered,
+    })
 }
 
 #[cfg(test)]
@@ -298,6 +350,49 @@ mod destination_tests {
         assert_eq!(registered.len(), 1, "{registered:?}");
         assert!(!registered[0].exists());
         assert!(!temporary_files().contains(&registered[0]));
+    }
+
+    #[test]
+    fn a_failing_file_of_several_leaves_every_destination_untouched() {
+        let dir = tempfile::tempdir().unwrap();
+        let (a, b) = (dir.path().join("a.obj"), dir.path().join("b.json"));
+        std::fs::write(&a, b"old").unwrap();
+        let err = atomic_write_all(vec![
+            (
+                a.as_path(),
+                Box::new(|w: &mut dyn Write| w.write_all(b"new")),
+            ),
+            (
+                b.as_path(),
+                Box::new(|_: &mut dyn Write| Err(std::io::Error::from_raw_os_error(28))),
+            ),
+        ])
+        .unwrap_err();
+        assert!(err.to_string().contains("b.json"), "{err}");
+        assert_eq!(std::fs::read(&a).unwrap(), b"old");
+        assert_eq!(files(dir.path()), ["a.obj"]);
+        atomic_write_all(vec![
+            (
+                a.as_path(),
+                Box::new(|w: &mut dyn Write| w.write_all(b"new")),
+            ),
+            (
+                b.as_path(),
+                Box::new(|w: &mut dyn Write| w.write_all(b"{}")),
+            ),
+        ])
+        .unwrap();
+        assert_eq!(std::fs::read(&a).unwrap(), b"new");
+        assert_eq!(files(dir.path()), ["a.obj", "b.json"]);
+    }
+
+    fn files(dir: &Path) -> Vec<String> {
+        let mut names: Vec<String> = std::fs::read_dir(dir)
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .collect();
+        names.sort();
+        names
     }
 
     #[test]

@@ -40,7 +40,10 @@ mod text;
 
 use std::path::Path;
 
-pub use atomic::{atomic_write, check_writable, remove_temporary_files, write_destination};
+pub use atomic::{
+    FileContent, atomic_write, atomic_write_all, check_writable, remove_temporary_files,
+    write_destination,
+};
 pub use error::{IoError, Location};
 pub use image_dump::{write_exr_rgba, write_png_rgba8};
 pub use obj::{read_obj, write_obj};
@@ -134,15 +137,37 @@ pub fn write_mesh_with(
     soup: &TriangleSoup,
     options: &WriteOptions,
 ) -> Result<(), IoError> {
+    write_mesh_and_files(path, soup, options, &[])
+}
+
+/// Writes `soup` (as [`write_mesh_with`]) and the byte files `others` all or nothing
+/// ([`atomic_write_all`]): a mesh and its report, where a report that cannot be written must not
+/// leave the mesh behind.
+pub fn write_mesh_and_files(
+    path: &Path,
+    soup: &TriangleSoup,
+    options: &WriteOptions,
+    others: &[(&Path, &[u8])],
+) -> Result<(), IoError> {
     let format = MeshFormat::from_path(path)?;
     soup.validate().map_err(|defect| IoError::InvalidInput {
         path: path.to_path_buf(),
         message: format!("cannot write an invalid mesh: {defect}"),
     })?;
-    atomic_write(path, |w| match format {
-        MeshFormat::Obj => write_obj(w, soup),
-        MeshFormat::Ply => write_ply(w, soup, options.ply),
-        MeshFormat::Stl => write_stl(w, soup, options.stl),
-        MeshFormat::Off => write_off(w, soup),
-    })
+    let mut files: Vec<(&Path, FileContent<'_>)> = vec![(
+        path,
+        Box::new(move |w: &mut dyn std::io::Write| match format {
+            MeshFormat::Obj => write_obj(w, soup),
+            MeshFormat::Ply => write_ply(w, soup, options.ply),
+            MeshFormat::Stl => write_stl(w, soup, options.stl),
+            MeshFormat::Off => write_off(w, soup),
+        }),
+    )];
+    for &(other, bytes) in others {
+        files.push((
+            other,
+            Box::new(move |w: &mut dyn std::io::Write| w.write_all(bytes)),
+        ));
+    }
+    atomic_write_all(files)
 }

@@ -67,7 +67,7 @@ pub struct ReconstructReport {
     pub output: String,
     /// Seed of the run.
     pub seed: u64,
-    /// Seconds for the whole command.
+    /// Seconds for the whole command, up to writing the files.
     pub seconds_total: f64,
     /// Metrics of the input as read (self-intersections skipped: soups can be huge).
     pub input_metrics: Report,
@@ -137,7 +137,6 @@ pub fn run(args: &ReconstructArgs) -> anyhow::Result<()> {
         Some((&soup.positions, &soup.triangles)),
         &EvalOptions::default(),
     )?;
-    roar_io::write_mesh(output, &out_soup)?;
     let report = ReconstructReport {
         input: input.display().to_string(),
         output: output.display().to_string(),
@@ -156,9 +155,18 @@ pub fn run(args: &ReconstructArgs) -> anyhow::Result<()> {
         );
     }
     let json = serde_json::to_string_pretty(&report)?;
-    if let Some(path) = &args.report {
-        roar_io::atomic_write(path, |w| w.write_all(json.as_bytes()))?;
-    }
+    // The mesh and the report are written all or nothing.
+    let others: Vec<(&std::path::Path, &[u8])> = args
+        .report
+        .iter()
+        .map(|path| (path.as_path(), json.as_bytes()))
+        .collect();
+    roar_io::write_mesh_and_files(
+        output,
+        &out_soup,
+        &roar_io::WriteOptions::default(),
+        &others,
+    )?;
     if !args.quiet {
         println!("{json}");
     }

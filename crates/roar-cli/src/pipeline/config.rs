@@ -384,10 +384,8 @@ impl FieldRange {
     /// 0 (off) or `min ..= max`.
     pub const fn zero_or(name: &'static str, min: f64, max: f64) -> Self {
         Self {
-            name,
-            min,
-            max,
             zero_is_off: true,
+            ..Self::new(name, min, max)
         }
     }
 
