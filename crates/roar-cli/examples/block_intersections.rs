@@ -82,7 +82,7 @@ fn main() {
         })
         .collect();
     let out = reconstruction
-        .run(&soup.positions, &soup.triangles, &mut |_| {})
+        .run_soup(&soup.positions, &soup.triangles, &mut |_| {})
         .expect("reconstruction");
     println!(
         "untangle failures {:?}, finished from iteration {}",

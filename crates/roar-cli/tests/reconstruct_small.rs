@@ -42,7 +42,7 @@ fn run_with(
     let mut reconstruction = Reconstruction::new(config);
     reconstruction.blocks.extend(extra);
     let out = reconstruction
-        .run(&soup.positions, &soup.triangles, &mut |p| {
+        .run_soup(&soup.positions, &soup.triangles, &mut |p| {
             stages.push(p.stage)
         })
         .unwrap();

@@ -10,11 +10,14 @@
 //!   → smoothing → data flips → polish → denormalize
 //! ```
 //!
+//! The input is any [`Shape`] (the soup is [`SoupShape`]): the pipeline asks it for its
+//! normalization, target renders, point cloud and initial mesh, and never which kind it is.
 //! A researcher swaps a piece without forking a crate: [`Reconstruction::loss_factory`] builds
-//! the objective from the prepared target, and [`Reconstruction::blocks`] is the remeshing
+//! the objective from what the shape gave, and [`Reconstruction::blocks`] is the remeshing
 //! schedule (any [`Block`]).
 
 pub mod config;
+pub mod soup;
 
 use std::collections::BTreeMap;
 use std::time::Instant;
@@ -22,10 +25,9 @@ use std::time::Instant;
 use glam::DVec3;
 use roar_loss::{
     KnnOptions, KnnPlanarProjector, Loss, LossError, PlanarLoss, PlanarOptions, PointCloud,
-    PointCloudOptions, RenderLoss, SharpEdgeOptions, Target, TargetOptions, WeightedSum,
-    build_target, point_cloud, sharp_edge_samples, two_sided_faces,
+    RenderLoss, Shape, ShapeError, SignedDistance, TargetOptions, WeightedSum,
 };
-use roar_mesh::spatial::{Aabb, Normalization, self_intersecting_faces};
+use roar_mesh::spatial::{Aabb, Normalization, Projector, self_intersecting_faces};
 use roar_mesh::{EdgeId, Mesh};
 use roar_ops::block::{Block, BlockContext, BlockStats};
 use roar_ops::collapse_block::{FaceCollapse, FaceCollapseOptions};
@@ -33,16 +35,18 @@ use roar_ops::data_flips::{DataFlipOptions, flip_toward_target};
 use roar_ops::degenerate::{DegenerateOptions, collapse_degenerate_faces};
 use roar_ops::flips::FlipOptions;
 use roar_ops::geometry::{DEGENERATE_QUALITY, is_degenerate, triangle_quality};
-use roar_ops::init::{InitError, InitOptions, InitialMeshOptions};
+use roar_ops::init::InitError;
 use roar_ops::optim::{Optimizer, OptimizerOptions};
 use roar_ops::qem::{DecimateError, DecimateOptions, DecimateStats, decimate};
 use roar_ops::slivers::{SliverOptions, flip_slivers};
 use roar_ops::smoothing::{SmoothingOptions, TangentialSmoothing};
 use roar_ops::split_block::{FaceSplit, FaceSplitOptions, SplitThreshold};
 use roar_ops::untangle::{LimiterOptions, UntangleOptions, UntangleStats, limit_steps, untangle};
+use roar_render::{Camera, Image, star_cameras};
 use serde::Serialize;
 
 pub use config::{InitKind, ReconstructConfig};
+pub use soup::SoupShape;
 
 /// Why a reconstruction failed.
 #[derive(Debug, thiserror::Error)]
@@ -56,6 +60,9 @@ pub enum PipelineError {
     /// The watertight init failed.
     #[error("init: {0}")]
     Init(#[from] InitError),
+    /// The input shape could not give what the pipeline asked for.
+    #[error("{0}")]
+    Shape(#[from] ShapeError),
     /// A mesh that must be a closed manifold is not (a bug in an operator).
     #[error("internal: {0}")]
     Internal(String),
@@ -67,12 +74,17 @@ pub enum PipelineError {
     Intersections(usize),
 }
 
-/// What the pipeline hands to a loss factory.
+/// What the pipeline hands to a loss factory: what the input [`Shape`] gave, in rig
+/// coordinates.
 pub struct Prepared<'a> {
-    /// The cleaned, normalized target and its renders.
-    pub target: &'a Target,
+    /// The camera rig ([`rig_cameras`]).
+    pub cameras: &'a [Camera],
+    /// The shape's target normal map for each camera.
+    pub renders: &'a [Image],
     /// The oriented target point cloud P (with the sharp-edge samples).
     pub cloud: &'a PointCloud,
+    /// The shape's signed distance, if it has one.
+    pub signed_distance: Option<&'a dyn SignedDistance>,
     /// The effective configuration.
     pub config: &'a ReconstructConfig,
 }
@@ -223,11 +235,23 @@ impl Reconstruction {
         }
     }
 
-    /// Runs the whole pipeline on a soup (any coordinates), reporting progress.
-    pub fn run(
+    /// Runs the whole pipeline on a soup (any coordinates): [`Reconstruction::run`] on a
+    /// [`SoupShape`] with this reconstruction's config.
+    pub fn run_soup(
         &mut self,
         positions: &[DVec3],
         triangles: &[[u32; 3]],
+        progress: &mut dyn FnMut(&Progress),
+    ) -> Result<Output, PipelineError> {
+        let mut shape = SoupShape::new("soup", positions, triangles, &self.config);
+        self.run(&mut shape, progress)
+    }
+
+    /// Runs the whole pipeline on `shape` (the [`Shape`] module docs give the order of the
+    /// calls), reporting progress; the output is in the input's coordinates.
+    pub fn run(
+        &mut self,
+        shape: &mut dyn Shape,
         progress: &mut dyn FnMut(&Progress),
     ) -> Result<Output, PipelineError> {
         let config = self.config.clone();
@@ -245,17 +269,26 @@ impl Reconstruction {
         };
 
         report("target", 0, f64::NAN, 0);
-        let target = build_target(positions, triangles, &target_options(&config))?;
-        stats.target_faces = target.triangles.len();
-        stats.twins_dropped = target.stats.twins_dropped;
+        let cameras = rig_cameras(&config);
+        shape.prepare(&cameras)?;
+        let normalization = shape.normalization();
+        let summary = shape.summary();
+        stats.target_faces = summary.target_faces;
+        stats.twins_dropped = summary.twins_dropped;
         clock.lap("target");
 
         report("init", 0, f64::NAN, 0);
-        let mut mesh = initial_mesh(&target, &config, &mut stats)?;
+        let mut mesh = initial_mesh(&*shape, &config, &mut stats)?;
         clock.lap("init");
 
         report("point_cloud", 0, f64::NAN, mesh.n_faces());
-        let cloud = target_cloud(&target, &mesh, &config)?;
+        let cloud = shape.point_cloud(&mesh)?;
+        if cloud.points.is_empty() || cloud.points.len() != cloud.normals.len() {
+            return Err(PipelineError::Loss(LossError::InvalidTarget(format!(
+                "{}: the point cloud is empty or has not one normal per point",
+                shape.name()
+            ))));
+        }
         stats.point_cloud = cloud.points.len();
         clock.lap("point_cloud");
 
@@ -270,11 +303,23 @@ impl Reconstruction {
         }
         clock.lap("working_budget_qem");
 
+        let renders = shape.target_renders(&cameras)?;
+        if renders.len() != cameras.len() {
+            return Err(PipelineError::Loss(LossError::InvalidTarget(format!(
+                "{}: {} target renders for {} cameras",
+                shape.name(),
+                renders.len(),
+                cameras.len()
+            ))));
+        }
         let mut loss = (self.loss_factory)(&Prepared {
-            target: &target,
+            cameras: &cameras,
+            renders: &renders,
             cloud: &cloud,
+            signed_distance: shape.signed_distance(),
             config: &config,
         })?;
+        drop(renders);
         let projector = KnnPlanarProjector::new(
             &cloud.points,
             &cloud.normals,
@@ -283,6 +328,8 @@ impl Reconstruction {
                 ..KnnOptions::default()
             },
         )?;
+        // The Face Split block's scores use the shape's own projector if it has one.
+        let block_projector: &dyn Projector = shape.projector().unwrap_or(&projector);
         let mut optimizer = new_optimizer(&mesh, &config)?;
         // The loop's state and its loss at every checkpoint iteration, to finish from.
         let mut states: Vec<LoopState> = Vec::new();
@@ -319,7 +366,7 @@ impl Reconstruction {
             let context = BlockContext {
                 iteration,
                 face_budget: budget,
-                projector: Some(&projector),
+                projector: Some(block_projector),
             };
             for scheduled in &mut self.blocks {
                 let due = scheduled.every > 0
@@ -371,7 +418,7 @@ impl Reconstruction {
             clock.lap("final_qem");
 
             if config.iterations > 0 && config.final_smoothing_sweeps > 0 {
-                mesh = smooth_if_clean(mesh, &target.normalization, &config, &mut stats);
+                mesh = smooth_if_clean(mesh, &normalization, &config, &mut stats);
                 clock.lap("final_smoothing");
             }
 
@@ -379,7 +426,7 @@ impl Reconstruction {
                 mesh = flip_toward_cloud_if_clean(
                     mesh,
                     &projector,
-                    &target.normalization,
+                    &normalization,
                     &config,
                     &mut stats,
                 );
@@ -392,7 +439,7 @@ impl Reconstruction {
                 mesh = polish(
                     mesh,
                     loss.as_mut(),
-                    &target.normalization,
+                    &normalization,
                     &config,
                     &mut stats,
                     &mut clock,
@@ -401,12 +448,12 @@ impl Reconstruction {
         }
         drop(loss);
         if config.iterations > 0 && config.sliver_quality > 0.0 {
-            mesh = remove_slivers_if_clean(mesh, &target.normalization, &config, &mut stats);
+            mesh = remove_slivers_if_clean(mesh, &normalization, &config, &mut stats);
             clock.lap("sliver_flips");
         }
 
         let (mut out_positions, out_triangles) = mesh.to_triangles();
-        target.normalization.invert_all(&mut out_positions);
+        normalization.invert_all(&mut out_positions);
         stats.seconds = clock.seconds;
         Ok(Output {
             positions: out_positions,
@@ -414,6 +461,17 @@ impl Reconstruction {
             stats,
         })
     }
+}
+
+/// The camera rig of `config` (spec §3.2.1: the star rig, `views_per_axis²` views of
+/// `render_resolution²` pixels), for which every shape renders its target.
+pub fn rig_cameras(config: &ReconstructConfig) -> Vec<Camera> {
+    star_cameras(
+        config.views_per_axis,
+        config.views_per_axis,
+        config.render_resolution,
+        config.render_resolution,
+    )
 }
 
 /// The target renders' options of `config` (spec §3.1, §3.2.1), as the pipeline uses them.
@@ -452,7 +510,7 @@ pub fn default_loss(prepared: &Prepared) -> Result<Box<dyn Loss>, PipelineError>
         WeightedSum::default()
             .with(
                 config.render_weight,
-                Box::new(RenderLoss::new(prepared.target)),
+                Box::new(RenderLoss::from_renders(prepared.cameras, prepared.renders)),
             )
             .with(config.planar_weight, Box::new(planar)),
     ))
@@ -503,26 +561,18 @@ pub fn default_blocks(config: &ReconstructConfig) -> Vec<ScheduledBlock> {
     ]
 }
 
-/// M0: the watertight init of T′ (or an icosphere), decimated to at most `init_max_faces`.
+/// M0: the shape's own initial mesh (for a soup the watertight init of T′, decimated to at
+/// most `init_max_faces`), or an icosphere of radius 0.5 (`init = "sphere"`).
 fn initial_mesh(
-    target: &Target,
+    shape: &dyn Shape,
     config: &ReconstructConfig,
     stats: &mut RunStats,
 ) -> Result<Mesh, PipelineError> {
     let mesh = match config.init {
         InitKind::Watertight => {
-            let options = InitialMeshOptions {
-                init: InitOptions {
-                    resolution: config.init_resolution,
-                    ..InitOptions::default()
-                },
-                max_faces: config.init_max_faces,
-                ..InitialMeshOptions::default()
-            };
-            let (mesh, init_stats) =
-                roar_ops::init::initial_mesh(&target.positions, &target.triangles, &options)?;
-            stats.init_voxel_faces = init_stats.init_faces;
-            mesh
+            let initial = shape.initial_mesh()?;
+            stats.init_voxel_faces = initial.raw_faces;
+            initial.mesh
         }
         InitKind::Sphere => {
             let mut sphere = roar_mesh::shapes::icosphere(config.sphere_level);
@@ -537,49 +587,6 @@ fn initial_mesh(
     stats.init_components = mesh.components().0;
     stats.init_genus = mesh.genus();
     Ok(mesh)
-}
-
-/// P: winding-filtered samples of T′ plus samples on the sharp edges of M0 (spec §3.1 b, c).
-fn target_cloud(
-    target: &Target,
-    m0: &Mesh,
-    config: &ReconstructConfig,
-) -> Result<PointCloud, PipelineError> {
-    let diagonal =
-        Aabb::from_points(target.positions.iter().copied()).map_or(0.0, |b| b.diagonal());
-    let sheet_offset = config.sheet_offset * diagonal;
-    let mut cloud = point_cloud(
-        target,
-        &PointCloudOptions {
-            samples: config.point_cloud_samples,
-            winding_threshold: config.winding_threshold,
-            sheet_offset,
-            seed: config.seed,
-            ..PointCloudOptions::default()
-        },
-    )?;
-    if config.sharp_edge_samples > 0 {
-        let (positions, triangles) = m0.to_triangles();
-        let sharp = sharp_edge_samples(
-            &target.bvh(),
-            &two_sided_faces(&target.triangles),
-            &positions,
-            &triangles,
-            &SharpEdgeOptions {
-                samples: config.sharp_edge_samples,
-                sheet_offset,
-                seed: config.seed,
-                ..SharpEdgeOptions::default()
-            },
-        )?;
-        cloud.extend(sharp);
-    }
-    if cloud.points.is_empty() {
-        return Err(PipelineError::Loss(LossError::InvalidTarget(
-            "no target sample survived the winding-number filter".into(),
-        )));
-    }
-    Ok(cloud)
 }
 
 /// A fresh optimizer for `mesh` with the configured learning rate and Laplacian weight.
