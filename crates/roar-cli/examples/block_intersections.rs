@@ -7,7 +7,7 @@
 use roar_cli::pipeline::{ReconstructConfig, Reconstruction, ScheduledBlock};
 use roar_mesh::Mesh;
 use roar_mesh::spatial::count_intersecting_faces;
-use roar_ops::block::{Block, BlockContext, BlockStats};
+use roar_ops::blocks::block::{Block, BlockContext, BlockStats};
 use roar_ops::optim::Optimizer;
 use std::cell::RefCell;
 use std::collections::BTreeMap;

@@ -5,7 +5,7 @@
 use std::path::PathBuf;
 
 use clap::Args;
-use roar_ops::qem::{DecimateOptions, decimate_in_parallel};
+use roar_ops::decimate::{DecimateOptions, decimate_in_parallel};
 
 use crate::input::{read_closed_mesh, write_mesh};
 

@@ -27,20 +27,21 @@ use roar_loss::{
     KnnOptions, KnnPlanarProjector, Loss, LossError, PlanarLoss, PlanarOptions, PointCloud,
     RenderLoss, Shape, ShapeError, SignedDistance, TargetOptions, WeightedSum,
 };
-use roar_mesh::spatial::{Aabb, Normalization, Projector, self_intersecting_faces};
-use roar_mesh::{EdgeId, Mesh};
-use roar_ops::block::{Block, BlockContext, BlockStats};
-use roar_ops::collapse_block::{FaceCollapse, FaceCollapseOptions};
-use roar_ops::data_flips::{DataFlipOptions, flip_toward_target};
-use roar_ops::degenerate::{DegenerateOptions, collapse_degenerate_faces};
-use roar_ops::flips::FlipOptions;
-use roar_ops::geometry::{DEGENERATE_QUALITY, is_degenerate, triangle_quality};
+use roar_mesh::Mesh;
+use roar_mesh::spatial::{Normalization, Projector, self_intersecting_faces};
+use roar_ops::blocks::block::{Block, BlockContext, BlockStats};
+use roar_ops::blocks::collapse::{FaceCollapse, FaceCollapseOptions};
+use roar_ops::blocks::flips::FlipOptions;
+use roar_ops::blocks::smoothing::{SmoothingOptions, TangentialSmoothing};
+use roar_ops::blocks::split::{FaceSplit, FaceSplitOptions, SplitThreshold};
+use roar_ops::decimate::{DecimateError, DecimateOptions, DecimateStats, decimate};
+use roar_ops::finish::data_flips::{DataFlipOptions, flip_toward_target};
+use roar_ops::finish::degenerate::{DegenerateOptions, collapse_degenerate_faces};
+use roar_ops::finish::fill::fill_to_budget;
+use roar_ops::finish::offset::offset_outward;
+use roar_ops::finish::slivers::{SliverOptions, flip_slivers};
 use roar_ops::init::InitError;
 use roar_ops::optim::{Optimizer, OptimizerOptions};
-use roar_ops::qem::{DecimateError, DecimateOptions, DecimateStats, decimate};
-use roar_ops::slivers::{SliverOptions, flip_slivers};
-use roar_ops::smoothing::{SmoothingOptions, TangentialSmoothing};
-use roar_ops::split_block::{FaceSplit, FaceSplitOptions, SplitThreshold};
 use roar_ops::untangle::{LimiterOptions, UntangleOptions, UntangleStats, limit_steps, untangle};
 use roar_render::{Camera, Image, star_cameras};
 use serde::Serialize;
@@ -690,8 +691,8 @@ fn polish(
     Ok(if clean { best } else { mesh })
 }
 
-/// The sliver flips of `roar_ops::slivers` on the final mesh; then, for the degenerate faces
-/// they leave, the collapses of `roar_ops::degenerate`, the face count restored by edge splits
+/// The sliver flips of `roar_ops::finish::slivers` on the final mesh; then, for the degenerate faces
+/// they leave, the collapses of `roar_ops::finish::degenerate`, the face count restored by edge splits
 /// ([`fill_to_budget`], which moves no geometry), and the flips once more. Kept only if the result is
 /// free of self-intersections in the input's coordinates, where it will be written (everything
 /// is checked exactly in the normalized ones; undoing the normalization rounds).
@@ -701,24 +702,43 @@ fn remove_slivers_if_clean(
     config: &ReconstructConfig,
     stats: &mut RunStats,
 ) -> Mesh {
-    let mut cleaned = mesh.clone();
     let options = SliverOptions {
         max_quality: config.sliver_quality,
         ..SliverOptions::default()
     };
-    let mut flips = flip_slivers(&mut cleaned, &options).accepted;
-    let faces = cleaned.n_faces();
-    let collapses = collapse_degenerate_faces(&mut cleaned, &DegenerateOptions::default()).accepted;
-    if collapses > 0 {
-        fill_to_budget(&mut cleaned, faces);
-        flips += flip_slivers(&mut cleaned, &options).accepted;
+    let (mut flips, mut collapses) = (0, 0);
+    let (mesh, changes) = keep_if_clean(mesh, normalization, |cleaned| {
+        flips = flip_slivers(cleaned, &options).accepted;
+        let faces = cleaned.n_faces();
+        collapses = collapse_degenerate_faces(cleaned, &DegenerateOptions::default()).accepted;
+        if collapses > 0 {
+            fill_to_budget(cleaned, faces);
+            flips += flip_slivers(cleaned, &options).accepted;
+        }
+        flips + collapses
+    });
+    if changes > 0 {
+        stats.sliver_flips = flips;
+        stats.degenerate_collapses = collapses;
     }
-    if flips + collapses == 0 || !clean_in_output_coordinates(&cleaned, normalization) {
-        return mesh;
+    mesh
+}
+
+/// The finish's one pattern for a step that must not make the output intersect itself: runs
+/// `step` on a copy of `mesh` (`step` returns how many changes it made) and returns the copy
+/// and that count if it is positive and the copy is free of self-intersections in the input's
+/// coordinates ([`clean_in_output_coordinates`]); otherwise `mesh` as it was and 0.
+fn keep_if_clean(
+    mesh: Mesh,
+    normalization: &Normalization,
+    step: impl FnOnce(&mut Mesh) -> usize,
+) -> (Mesh, usize) {
+    let mut changed = mesh.clone();
+    let changes = step(&mut changed);
+    if changes == 0 || !clean_in_output_coordinates(&changed, normalization) {
+        return (mesh, 0);
     }
-    stats.sliver_flips = flips;
-    stats.degenerate_collapses = collapses;
-    cleaned
+    (changed, changes)
 }
 
 /// Whether `mesh`, with the normalization undone (as it will be written), is free of
@@ -733,58 +753,12 @@ fn clean_in_output_coordinates(mesh: &Mesh, normalization: &Normalization) -> bo
 /// The triangles of a compact mesh (compacting it, and the optimizer with it, if needed).
 fn compact_triangles(mesh: &mut Mesh, optimizer: &mut Optimizer) -> Vec<[u32; 3]> {
     if mesh.vertex_capacity() != mesh.n_vertices() || mesh.face_capacity() != mesh.n_faces() {
-        roar_ops::block::compact_with_optimizer(mesh, optimizer);
+        roar_ops::optim::compact_with_optimizer(mesh, optimizer);
     }
-    roar_ops::block::sync_optimizer_len(mesh, optimizer);
+    roar_ops::optim::sync_optimizer_len(mesh, optimizer);
     mesh.faces()
         .map(|f| mesh.face_vertices(f).map(|v| v.raw()))
         .collect()
-}
-
-/// Splits edges at their midpoints until the mesh has `faces` faces (each split adds two),
-/// longest first, skipping edges whose halving would leave a degenerate face
-/// ([`bisects_well`]): halving a needle's long edge leaves two needles and halving a flat
-/// cap's edge can make a flatter one, which would undo the degenerate collapses this fill
-/// follows. When no edge qualifies the longest is split anyway, so the fill always ends. The
-/// geometry does not change, so no intersection can appear. Returns the split count.
-fn fill_to_budget(mesh: &mut Mesh, faces: usize) -> usize {
-    let mut splits = 0;
-    while mesh.n_faces() < faces {
-        let mut edges: Vec<(f64, EdgeId)> = mesh
-            .edges()
-            .filter(|&e| bisects_well(mesh, e))
-            .map(|e| (mesh.edge_length(e), e))
-            .collect();
-        if edges.is_empty() {
-            edges = mesh.edges().map(|e| (mesh.edge_length(e), e)).collect();
-        }
-        // Longest first; ties by id keep it deterministic.
-        edges.sort_by(|a, b| b.0.total_cmp(&a.0).then(a.1.cmp(&b.1)));
-        let wanted = (faces - mesh.n_faces()) / 2;
-        for &(_, e) in edges.iter().take(wanted.max(1)) {
-            if mesh.n_faces() >= faces {
-                break;
-            }
-            mesh.split_edge(e, 0.5);
-            splits += 1;
-        }
-    }
-    mesh.compact();
-    splits
-}
-
-/// Whether halving `e` leaves no degenerate face ([`DEGENERATE_QUALITY`]): neither face of `e`
-/// is degenerate, nor is any of the four faces the split would make (see [`fill_to_budget`]).
-fn bisects_well(mesh: &Mesh, e: EdgeId) -> bool {
-    let h = mesh.edge_halfedge(e);
-    [h, h.twin()].into_iter().all(|h| {
-        let (a, b) = (mesh.position(mesh.tail(h)), mesh.position(mesh.head(h)));
-        let c = mesh.position(mesh.head(mesh.next(h)));
-        let m = 0.5 * (a + b);
-        [[a, b, c], [a, m, c], [m, b, c]]
-            .into_iter()
-            .all(|t| !is_degenerate(triangle_quality(t), DEGENERATE_QUALITY))
-    })
 }
 
 /// Fills the mesh up to `config.faces`, runs the untangle block and fills again (its collapses
@@ -818,15 +792,13 @@ fn smooth_if_clean(
         guard_intersections: true,
         ..SmoothingOptions::default()
     };
-    let mut smoothed = mesh.clone();
-    let moves: usize = (0..config.final_smoothing_sweeps)
-        .map(|_| roar_ops::smoothing::tangential_smoothing(&mut smoothed, &options).accepted)
-        .sum();
-    if moves == 0 || !clean_in_output_coordinates(&smoothed, normalization) {
-        return mesh;
-    }
+    let (mesh, moves) = keep_if_clean(mesh, normalization, |smoothed| {
+        (0..config.final_smoothing_sweeps)
+            .map(|_| roar_ops::blocks::smoothing::tangential_smoothing(smoothed, &options).accepted)
+            .sum()
+    });
     stats.final_smoothing_moves += moves;
-    smoothed
+    mesh
 }
 
 /// `config.data_flip_rounds` rounds of data-dependent flips toward the normals of the point cloud
@@ -849,43 +821,11 @@ fn flip_toward_cloud_if_clean(
         max_rounds: config.data_flip_rounds,
         ..DataFlipOptions::default()
     };
-    let mut flipped = mesh.clone();
-    let flips = flip_toward_target(&mut flipped, &target_normal, &options).accepted;
-    if flips == 0 || !clean_in_output_coordinates(&flipped, normalization) {
-        return mesh;
-    }
+    let (mesh, flips) = keep_if_clean(mesh, normalization, |flipped| {
+        flip_toward_target(flipped, &target_normal, &options).accepted
+    });
     stats.data_flips += flips;
-    flipped
-}
-
-/// Moves every vertex `relative × diagonal` outward along its normal, each move shortened or
-/// cancelled where it would make faces intersect; returns how many vertices moved the whole way.
-///
-/// Why: the optimization pulls the two sides of a thin part (and of an open surface, which the
-/// init wraps from both sides) onto the same sheet, closer than any chord the final QEM makes,
-/// so its self-intersection veto refuses nearly every collapse there and the decimation eats
-/// the part from its rim instead. Offset apart, the two sides decimate like any other surface;
-/// the polish then moves the vertices back onto the target.
-fn offset_outward(mesh: &mut Mesh, relative: f64) -> usize {
-    // Compact, the mesh's vertex ids are the indices of `to_triangles`.
-    mesh.compact();
-    let (positions, triangles) = mesh.to_triangles();
-    let diagonal = Aabb::from_points(positions.iter().copied()).map_or(0.0, |b| b.diagonal());
-    let distance = relative * diagonal;
-    let normals = roar_loss::planar::vertex_normals(&positions, &triangles);
-    let mut moved: Vec<DVec3> = positions
-        .iter()
-        .zip(&normals)
-        .map(|(&p, &n)| p + distance * n)
-        .collect();
-    let limited = limit_steps(
-        &positions,
-        &mut moved,
-        &triangles,
-        &LimiterOptions::default(),
-    );
-    mesh.positions_mut().copy_from_slice(&moved);
-    positions.len() - limited.shortened - limited.cancelled
+    mesh
 }
 
 /// The face counts the finish decimates to, each followed by a polish: `[2N, N]` when the
@@ -1009,8 +949,12 @@ impl StageClock {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use roar_mesh::EdgeId;
     use roar_mesh::shapes::icosphere;
+    use roar_mesh::spatial::Aabb;
     use roar_mesh::spatial::count_intersecting_faces;
+    use roar_ops::finish::fill::bisects_well;
+    use roar_ops::geometry::{DEGENERATE_QUALITY, is_degenerate, triangle_quality};
 
     /// Faces at or above [`DEGENERATE_QUALITY`].
     fn degenerate_faces(mesh: &Mesh) -> usize {
