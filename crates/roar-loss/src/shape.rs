@@ -71,8 +71,9 @@ pub trait SignedDistance: Sync {
 /// coordinates and orientation).
 ///
 /// A shape may cache anything it computes: the pipeline calls [`Shape::prepare`] once and every
-/// other method at most once per run, so what a method costs is paid once; the costs below are
-/// those of the soup implementation.
+/// other method but [`Shape::name`] at most once per run, so what a method costs is paid once
+/// (and [`Shape::initial_mesh`] not at all when the config asks for the sphere init); the costs
+/// below are those of the soup implementation.
 pub trait Shape {
     /// A short name for reports and messages (e.g. the input's file name).
     fn name(&self) -> &str;
