@@ -13,11 +13,11 @@ use rand_chacha::ChaCha8Rng;
 use roar_mesh::shapes::perturbed;
 use roar_mesh::spatial::{Projector, SphereProjector, regular_sample_points};
 use roar_mesh::{DVec3, Mesh};
-use roar_ops::collapse_block::{FaceCollapseOptions, face_collapse};
+use roar_ops::blocks::collapse::{FaceCollapseOptions, face_collapse};
+use roar_ops::blocks::smoothing::{SmoothingOptions, tangential_smoothing};
+use roar_ops::blocks::split::{FaceSplitOptions, SplitThreshold, face_split};
 use roar_ops::geometry::Geometry;
 use roar_ops::optim::{Optimizer, OptimizerOptions};
-use roar_ops::smoothing::{SmoothingOptions, tangential_smoothing};
-use roar_ops::split_block::{FaceSplitOptions, SplitThreshold, face_split};
 use roar_ops::untangle::{LimiterOptions, limit_steps};
 use std::hint::black_box;
 

@@ -7,7 +7,7 @@
 use roar_cli::pipeline::{ReconstructConfig, Reconstruction, ScheduledBlock};
 use roar_mesh::Mesh;
 use roar_mesh::spatial::count_intersecting_faces;
-use roar_ops::block::{Block, BlockContext, BlockStats};
+use roar_ops::blocks::block::{Block, BlockContext, BlockStats};
 use roar_ops::optim::Optimizer;
 use std::cell::RefCell;
 use std::collections::BTreeMap;
@@ -82,7 +82,7 @@ fn main() {
         })
         .collect();
     let out = reconstruction
-        .run(&soup.positions, &soup.triangles, &mut |_| {})
+        .run_soup(&soup.positions, &soup.triangles, &mut |_| {})
         .expect("reconstruction");
     println!(
         "untangle failures {:?}, finished from iteration {}",

@@ -10,8 +10,8 @@ use roar_loss::{
     Loss, PlanarLoss, PlanarOptions, PointCloudOptions, RenderLoss, TargetOptions, build_target,
     point_cloud,
 };
+use roar_ops::decimate::{DecimateOptions, decimate};
 use roar_ops::init::{InitialMeshOptions, initial_mesh};
-use roar_ops::qem::{DecimateOptions, decimate};
 
 fn mean_norm(g: &[DVec3]) -> f64 {
     g.iter().map(|v| v.length()).sum::<f64>() / g.len() as f64

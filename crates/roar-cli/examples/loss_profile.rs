@@ -108,7 +108,7 @@ fn dump(mesh: &Path, state: &Path, faces: usize, at: usize) -> anyhow::Result<()
             }))
         },
     );
-    let result = run.run(&soup.positions, &soup.triangles, &mut |_| {});
+    let result = run.run_soup(&soup.positions, &soup.triangles, &mut |_| {});
     match result {
         Err(e) if e.to_string().contains("dumped, stopping") => {
             println!("wrote {}", state.display());
@@ -244,8 +244,10 @@ fn eval(mesh: &Path, state: &Path, evals: usize, term: &str) -> anyhow::Result<(
                 Box::new(RenderLoss::new(&target))
             } else {
                 default_loss(&Prepared {
-                    target: &target,
+                    cameras: &target.cameras,
+                    renders: &target.renders,
                     cloud: &cloud,
+                    signed_distance: None,
                     config: &config,
                 })?
             }

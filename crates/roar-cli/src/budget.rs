@@ -1,10 +1,10 @@
 //! Face budgets a user may ask for, known before any work: a closed triangle mesh has an even face
 //! count (3F = 2E), and each closed piece needs at least the faces of the smallest triangulation
-//! of its genus (4 for a sphere, 14 for a torus: `roar_ops::qem::minimum_faces_for_genus`).
+//! of its genus (4 for a sphere, 14 for a torus: `roar_ops::decimate::minimum_faces_for_genus`).
 //! Every operator keeps the pieces and their genera, so this is the smallest budget a run can
 //! reach; the one place to change when the finish learns to remove handles.
 
-use roar_ops::qem::minimum_faces_for_genus;
+use roar_ops::decimate::minimum_faces_for_genus;
 
 /// The smallest face count a closed mesh with pieces of these genera can be decimated to while
 /// keeping its topology: the sum of each piece's minimum (`2(V − 2 + 2g)` with Heawood's vertex

@@ -94,11 +94,11 @@ fn reconstruct(name: &str, soup: &roar_io::TriangleSoup) -> Run {
         ..config.clone()
     };
     let baseline = Reconstruction::new(baseline_config)
-        .run(&soup.positions, &soup.triangles, &mut |_| {})
+        .run_soup(&soup.positions, &soup.triangles, &mut |_| {})
         .unwrap_or_else(|e| panic!("{name}, init + QEM: {e}"));
     let started = std::time::Instant::now();
     let out = Reconstruction::new(config)
-        .run(&soup.positions, &soup.triangles, &mut |_| {})
+        .run_soup(&soup.positions, &soup.triangles, &mut |_| {})
         .unwrap_or_else(|e| panic!("{name}: {e}"));
     Run {
         out,

@@ -4,7 +4,7 @@
 use roar_cli::pipeline::{InitKind, ReconstructConfig, Reconstruction, RunStats, ScheduledBlock};
 use roar_mesh::Mesh;
 use roar_mesh::spatial::self_intersecting_faces;
-use roar_ops::block::{Block, BlockContext, BlockStats};
+use roar_ops::blocks::block::{Block, BlockContext, BlockStats};
 use roar_ops::optim::Optimizer;
 
 fn toy_config(faces: usize) -> ReconstructConfig {
@@ -42,7 +42,7 @@ fn run_with(
     let mut reconstruction = Reconstruction::new(config);
     reconstruction.blocks.extend(extra);
     let out = reconstruction
-        .run(&soup.positions, &soup.triangles, &mut |p| {
+        .run_soup(&soup.positions, &soup.triangles, &mut |p| {
             stages.push(p.stage)
         })
         .unwrap();

@@ -3,7 +3,9 @@
 //! The reconstruction target (the cleaned soup T′, its renders, the oriented point cloud P) and
 //! the losses that drive the vertices: the render loss and the planar projection loss (spec
 //! §3.1–§3.4), behind the common [`Loss`] trait so a researcher can add or swap a term without
-//! touching the pipeline.
+//! touching the pipeline. [`Shape`] is the seam between an input of any kind and the pipeline:
+//! what it must offer (bounds, renders, a point cloud, an initial mesh, optionally a signed
+//! distance).
 
 pub mod knn_projector;
 pub mod planar;
@@ -17,6 +19,7 @@ use rayon::prelude::*;
 
 pub mod point_cloud;
 pub mod render_loss;
+pub mod shape;
 pub mod sharp_edges;
 pub mod target;
 
@@ -24,6 +27,7 @@ pub use point_cloud::{
     PointCloud, PointCloudOptions, point_cloud, point_cloud_of_soup, two_sided_faces,
 };
 pub use render_loss::RenderLoss;
+pub use shape::{InitialMesh, Shape, ShapeError, ShapeSummary, SignedDistance};
 pub use sharp_edges::{SharpEdge, SharpEdgeOptions, sharp_edge_samples, sharp_edges};
 pub use target::{Target, TargetOptions, TargetStats, build_target, render_views};
 

@@ -13,6 +13,8 @@ use rand_chacha::ChaCha8Rng;
 use roar_mesh::spatial::regular_sampling::{
     continuous_grid_size, face_grid, grid_point_count, round_grid_size,
 };
+/// The ROAR vertex normals (spec §2.2), a kernel of `roar_mesh::spatial`.
+pub use roar_mesh::spatial::vertex_normals;
 use roar_mesh::spatial::{RegularSamples, RegularSamplingOptions};
 
 use crate::knn_projector::{KnnOptions, KnnPlanarProjector, answers_in_order};
@@ -573,33 +575,6 @@ fn referenced_bbox_diagonal(positions: &[DVec3], triangles: &[[u32; 3]]) -> f64 
     } else {
         (hi - lo).length()
     }
-}
-
-/// ROAR vertex normals (spec §2.2): `N_v = Σ_{f∋v} A_f θ_{f,v} n_f`, normalized (area **times**
-/// corner angle). Degenerate faces (|cross| ≤ 1e-9) use normal (1,0,0) and area 1e-9, as the
-/// reference does. Vertices with a vanishing sum (or unreferenced) get a zero normal.
-/// Triangles with an out-of-range index are skipped.
-pub fn vertex_normals(positions: &[DVec3], triangles: &[[u32; 3]]) -> Vec<DVec3> {
-    let mut sums = vec![DVec3::ZERO; positions.len()];
-    for tri in triangles {
-        let Some(c) = corner_positions(positions, tri) else {
-            continue;
-        };
-        let cross = (c[1] - c[0]).cross(c[2] - c[0]);
-        let len = cross.length();
-        let (normal, area) = if len > 1e-9 {
-            (cross / len, 0.5 * len)
-        } else {
-            (DVec3::X, 1e-9)
-        };
-        for k in 0..3 {
-            let e1 = (c[(k + 1) % 3] - c[k]).normalize_or_zero();
-            let e2 = (c[(k + 2) % 3] - c[k]).normalize_or_zero();
-            let angle = e1.dot(e2).clamp(-1.0, 1.0).acos();
-            sums[tri[k] as usize] += area * angle * normal;
-        }
-    }
-    sums.into_iter().map(|n| n.normalize_or_zero()).collect()
 }
 
 /// Checks the source buffers: in-range indices and finite positions.

@@ -30,9 +30,15 @@ impl RenderLoss {
     /// antialiasing on, L1. Clones the renders (36 × 512² × 16 B ≈ 151 MB at the defaults);
     /// to avoid the copy, build the struct directly with `std::mem::take(&mut target.renders)`.
     pub fn new(target: &Target) -> Self {
+        Self::from_renders(&target.cameras, &target.renders)
+    }
+
+    /// The paper's render loss against `renders`, one per camera of `cameras` (as a
+    /// [`crate::Shape`] gives them): source culling off, antialiasing on, L1. Clones both.
+    pub fn from_renders(cameras: &[Camera], renders: &[Image]) -> Self {
         Self {
-            cameras: target.cameras.clone(),
-            targets: target.renders.clone(),
+            cameras: cameras.to_vec(),
+            targets: renders.to_vec(),
             options: RenderOptions::default(),
             kind: LossKind::L1,
         }

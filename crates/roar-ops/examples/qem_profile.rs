@@ -12,8 +12,8 @@ mod common;
 
 use roar_mesh::Mesh;
 use roar_mesh::shapes::{perturbed, torus};
+use roar_ops::decimate::{DecimateOptions, decimate, decimate_in_parallel};
 use roar_ops::init::{InitOptions, watertight_init};
-use roar_ops::qem::{DecimateOptions, decimate, decimate_in_parallel};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 

@@ -21,10 +21,10 @@ use rand_chacha::ChaCha8Rng;
 use roar_mesh::shapes::{genus_n_solid, icosphere, perturbed};
 use roar_mesh::spatial::{Projector, SphereProjector, regular_samples};
 use roar_mesh::{DVec3, Mesh};
+use roar_ops::blocks::qslim::{QSlimOptions, VertexPlane};
+use roar_ops::blocks::split::{FaceSplitOptions, SplitThreshold, face_scores, face_split};
 use roar_ops::geometry::Geometry;
 use roar_ops::optim::{Optimizer, OptimizerOptions};
-use roar_ops::qslim::{QSlimOptions, VertexPlane};
-use roar_ops::split_block::{FaceSplitOptions, SplitThreshold, face_scores, face_split};
 use std::time::Instant;
 
 /// Latitude–longitude unit sphere: `2·lon·(lat − 1)` faces (50 × 100 → 9800).

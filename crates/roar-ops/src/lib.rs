@@ -1,23 +1,32 @@
 //! # roar-ops
 //!
-//! The optimizer (Move Vertices), the remeshing blocks (Face Collapse, edge flips, Face Split,
-//! tangential smoothing, untangle), QEM decimation to an exact face count, and the initial meshes
-//! (watertight init from soups, SDF voxel init).
+//! The mesh algorithms of the reconstruction, one folder per stage of the pipeline, listed here
+//! in the order the pipeline runs them (DESIGN.md §2):
+//!
+//! | stage | module | what |
+//! |---|---|---|
+//! | init | [`init`] | the initial closed mesh M0: watertight voxel init of a soup, icosphere |
+//! | working budget, final QEM | [`decimate`] | QEM decimation to an exact face count |
+//! | loop: Move Vertices | [`optim`] | the optimizer, its per-vertex state and how that state follows the mesh |
+//! | loop: remeshing | [`blocks`] | the `Block` trait; Face Collapse, flips, Face Split, smoothing; candidate selection, edge costs, the intersection guard |
+//! | loop and finish | [`untangle`] | the step limiter and the untangle block |
+//! | finish | [`finish`] | fill to the budget, outward offset, data flips, sliver flips, degenerate collapses |
+//!
+//! Shared by several stages: [`geometry`] (per-mesh normals, quality measures) and a private
+//! exact face–face intersection test. Dependencies run down this table's stages and into the
+//! shared modules; no two modules import each other.
 
-pub mod block;
-pub mod collapse_block;
-pub mod data_flips;
-pub mod degenerate;
-pub mod flips;
-pub mod geometry;
-pub mod guard;
 pub mod init;
-mod intersect;
+
+pub mod decimate;
+
 pub mod optim;
-pub mod qem;
-pub mod qslim;
-pub mod select;
-pub mod slivers;
-pub mod smoothing;
-pub mod split_block;
+
+pub mod blocks;
+
 pub mod untangle;
+
+pub mod finish;
+
+pub mod geometry;
+mod intersect;

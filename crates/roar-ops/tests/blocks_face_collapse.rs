@@ -6,7 +6,7 @@ mod blocks_common;
 use blocks_common::{assert_contract, key, plant_fold, rows_by_position, tagged_optimizer};
 use roar_mesh::VertexId;
 use roar_mesh::shapes::icosphere;
-use roar_ops::collapse_block::{FaceCollapseOptions, face_collapse, flagged_faces};
+use roar_ops::blocks::collapse::{FaceCollapseOptions, face_collapse, flagged_faces};
 use roar_ops::geometry::Geometry;
 
 fn flagged_count(mesh: &roar_mesh::Mesh) -> usize {

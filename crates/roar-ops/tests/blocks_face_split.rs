@@ -8,9 +8,9 @@ use rand::SeedableRng;
 use roar_mesh::DVec3;
 use roar_mesh::shapes::{genus_n_solid, icosphere};
 use roar_mesh::spatial::{Projector, RegularSamples, SphereProjector, regular_samples};
+use roar_ops::blocks::qslim::{QSlimOptions, VertexPlane};
+use roar_ops::blocks::split::{FaceSplitOptions, SplitThreshold, face_scores, face_split};
 use roar_ops::geometry::Geometry;
-use roar_ops::qslim::{QSlimOptions, VertexPlane};
-use roar_ops::split_block::{FaceSplitOptions, SplitThreshold, face_scores, face_split};
 
 const UNIT_SPHERE: SphereProjector = SphereProjector {
     center: DVec3::ZERO,
@@ -332,7 +332,7 @@ fn run_calls(
 ) -> (
     roar_mesh::Mesh,
     roar_ops::optim::Optimizer,
-    Vec<roar_ops::block::BlockStats>,
+    Vec<roar_ops::blocks::block::BlockStats>,
 ) {
     let mut m = mesh.clone();
     let mut opt = tagged_optimizer(&m);

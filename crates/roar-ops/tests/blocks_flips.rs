@@ -6,7 +6,7 @@ use blocks_common::{random_mesh, valence_irregularity};
 use proptest::prelude::*;
 use roar_mesh::FaceId;
 use roar_mesh::shapes::{genus_n_solid, icosphere};
-use roar_ops::flips::{FlipOptions, flip_edges};
+use roar_ops::blocks::flips::{FlipOptions, flip_edges};
 use std::collections::HashSet;
 
 fn assert_no_duplicate_edges(mesh: &roar_mesh::Mesh) {

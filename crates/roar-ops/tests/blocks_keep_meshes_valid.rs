@@ -7,11 +7,11 @@ use blocks_common::{assert_contract, random_mesh, tagged_optimizer};
 use proptest::prelude::*;
 use roar_mesh::Mesh;
 use roar_mesh::spatial::{SphereProjector, count_intersecting_faces};
-use roar_ops::block::{Block, BlockContext};
-use roar_ops::collapse_block::{FaceCollapse, FaceCollapseOptions};
-use roar_ops::flips::{EdgeFlips, FlipOptions};
-use roar_ops::smoothing::{SmoothingOptions, TangentialSmoothing};
-use roar_ops::split_block::{FaceSplit, FaceSplitOptions, SplitThreshold};
+use roar_ops::blocks::block::{Block, BlockContext};
+use roar_ops::blocks::collapse::{FaceCollapse, FaceCollapseOptions};
+use roar_ops::blocks::flips::{EdgeFlips, FlipOptions};
+use roar_ops::blocks::smoothing::{SmoothingOptions, TangentialSmoothing};
+use roar_ops::blocks::split::{FaceSplit, FaceSplitOptions, SplitThreshold};
 
 fn blocks() -> Vec<Box<dyn Block>> {
     vec![

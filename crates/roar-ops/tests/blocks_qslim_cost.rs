@@ -3,11 +3,11 @@
 
 use roar_mesh::shapes::genus_n_solid;
 use roar_mesh::{DVec3, EdgeId, Mesh};
-use roar_ops::geometry::Geometry;
-use roar_ops::qslim::{
+use roar_ops::blocks::qslim::{
     QSlimOptions, ValidityOptions, VertexPlane, edge_cost, generalized_vertex_normal,
     vertex_quadrics,
 };
+use roar_ops::geometry::Geometry;
 
 /// An edge of the box whose two endpoints only touch faces with normal +z (a flat region).
 fn flat_edge(mesh: &Mesh) -> EdgeId {

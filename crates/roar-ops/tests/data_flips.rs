@@ -11,7 +11,7 @@ use proptest::prelude::*;
 use roar_mesh::DVec3;
 use roar_mesh::shapes::{cube, icosphere};
 use roar_mesh::spatial::count_intersecting_faces;
-use roar_ops::data_flips::{DataFlipOptions, flip_toward_target, target_normal_error};
+use roar_ops::finish::data_flips::{DataFlipOptions, flip_toward_target, target_normal_error};
 
 /// The normal of the face of the cube `[-0.5, 0.5]³` nearest to `p` (inside the cube: the axis of
 /// the largest coordinate).

@@ -9,9 +9,9 @@ use proptest::prelude::*;
 use roar_mesh::shapes::icosphere;
 use roar_mesh::spatial::count_intersecting_faces;
 use roar_mesh::{EdgeId, Mesh, VertexId};
-use roar_ops::degenerate::{DegenerateOptions, collapse_degenerate_faces};
+use roar_ops::finish::degenerate::{DegenerateOptions, collapse_degenerate_faces};
+use roar_ops::finish::slivers::{SliverOptions, flip_slivers};
 use roar_ops::geometry::{DEGENERATE_QUALITY, is_degenerate, triangle_quality};
-use roar_ops::slivers::{SliverOptions, flip_slivers};
 
 fn degenerate_faces(mesh: &Mesh) -> usize {
     mesh.faces()

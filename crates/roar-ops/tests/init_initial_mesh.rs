@@ -19,10 +19,10 @@ use roar_eval::{ChamferOptions, fidelity};
 use roar_io::{TriangleSoup, read_mesh};
 use roar_mesh::Mesh;
 use roar_mesh::spatial::TriangleBvh;
+use roar_ops::decimate::{DecimateError, DecimateOptions, decimate, minimum_faces};
 use roar_ops::init::{
     InitialMeshOptions, InitialMeshStats, WatertightInit, initial_mesh_from_init, watertight_init,
 };
-use roar_ops::qem::{DecimateError, DecimateOptions, decimate, minimum_faces};
 use std::fmt::Write as _;
 use std::panic::AssertUnwindSafe;
 use std::path::Path;

@@ -10,8 +10,8 @@ use proptest::prelude::*;
 use roar_mesh::shapes::{cube, icosphere};
 use roar_mesh::spatial::count_intersecting_faces;
 use roar_mesh::{FaceId, Mesh};
+use roar_ops::finish::slivers::{SliverOptions, flip_slivers};
 use roar_ops::geometry::triangle_quality;
-use roar_ops::slivers::{SliverOptions, flip_slivers};
 
 /// Splits `f` at a point close to the middle of its first edge: a cap (one angle near 180°).
 fn plant_cap(mesh: &mut Mesh, f: FaceId, closeness: f64) {

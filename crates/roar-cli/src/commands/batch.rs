@@ -228,6 +228,7 @@ fn reconstruct_args(
         report: None,
         print_config: false,
         quiet: true,
+        force: false,
     }
 }
 

@@ -5,7 +5,7 @@
 use std::path::PathBuf;
 
 use clap::Args;
-use roar_ops::qem::{DecimateOptions, decimate_in_parallel};
+use roar_ops::decimate::{DecimateOptions, decimate_in_parallel};
 
 use crate::budget::{check_budget, min_reachable_budget, parse_faces};
 use crate::checks::check_paths;

@@ -13,7 +13,7 @@ use roar_eval::{EvalOptions, Report};
 use serde::Serialize;
 
 use crate::checks::check_paths;
-use crate::pipeline::{InitKind, Progress, ReconstructConfig, Reconstruction, RunStats};
+use crate::pipeline::{InitKind, Progress, ReconstructConfig, Reconstruction, RunStats, SoupShape};
 
 /// Arguments of `roar reconstruct`.
 #[derive(Args, Debug)]
@@ -115,10 +115,18 @@ pub fn run(args: &ReconstructArgs) -> anyhow::Result<()> {
             });
         }
     };
+    // Every input `roar reconstruct` reads today is a triangle soup.
+    let name = input.file_name().map_or_else(
+        || input.display().to_string(),
+        |n| n.to_string_lossy().into_owned(),
+    );
+    let mut shape = SoupShape::new(name, &soup.positions, &soup.triangles, &config);
     let mut reconstruction = Reconstruction::new(config.clone());
     let result = reconstruction
-        .run(&soup.positions, &soup.triangles, &mut on_progress)
+        .run(&mut shape, &mut on_progress)
         .with_context(|| format!("{}: reconstruction failed", input.display()));
+    // The prepared target and its renders are not needed for the report.
+    drop(shape);
     if let Some(bar) = &bar {
         bar.finish_and_clear();
     }

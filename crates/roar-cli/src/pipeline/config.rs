@@ -120,7 +120,7 @@ pub struct ReconstructConfig {
     pub final_smoothing_sweeps: usize,
     /// Rounds of data-dependent edge flips at exactly N after the smoothing, before the polish
     /// (0 = off): an edge flips when the quad's other diagonal follows the point cloud's normals
-    /// better (`roar_ops::data_flips`), no face gets worse than `Q = 4` (or the worse old face)
+    /// better (`roar_ops::finish::data_flips`), no face gets worse than `Q = 4` (or the worse old face)
     /// and no intersection appears. [INF] Not in the paper: the valence flips, the smoothing and
     /// the final QEM choose the diagonals for the triangles' shapes and the working mesh's
     /// quadrics, not for the target's normals (docs/evaluation.md, fifteenth session).
@@ -137,7 +137,7 @@ pub struct ReconstructConfig {
     /// so the loop itself keeps the mesh intersection-free where the blocks did.
     pub step_limiter: bool,
     /// Let the blocks skip (collapses, flips) or shorten (smoothing moves) operations that would
-    /// make a face intersect another one (`roar_ops::guard`), so the loop's mesh stays
+    /// make a face intersect another one (`roar_ops::blocks::guard`), so the loop's mesh stays
     /// intersection-free and every checkpoint is recent. [INF] Not in the paper. Off by default,
     /// measured: it keeps folds the Face Collapse block would have removed, and the final
     /// untangle clears what the unguarded blocks leave (gpytoolbox-airplane at 1000 faces:
@@ -167,9 +167,9 @@ pub struct ReconstructConfig {
     /// Last step: flip the edges of faces with aspect ratio `Q = R/(2r)` above this when both
     /// faces of the edge get better, the two are nearly coplanar (0.95; against the other face
     /// alone when one is degenerate, above 100) and no intersection appears
-    /// (`roar_ops::slivers`; 0 = off); then degenerate faces (above 100) that no flip fixes are
+    /// (`roar_ops::finish::slivers`; 0 = off); then degenerate faces (above 100) that no flip fixes are
     /// removed by collapsing one of their edges, and the face count is restored by edge splits
-    /// that make no degenerate face (`roar_ops::degenerate`). [INF] Not in the paper: the optimization and
+    /// that make no degenerate face (`roar_ops::finish::degenerate`). [INF] Not in the paper: the optimization and
     /// the polish move vertices for the losses, and the final QEM bounds only the faces it
     /// creates, so a few caps (one angle near 180°) reach the output. Runs only when
     /// `iterations > 0`.

@@ -10,11 +10,14 @@
 //!   → smoothing → data flips → polish → denormalize
 //! ```
 //!
+//! The input is any [`Shape`] (the soup is [`SoupShape`]): the pipeline asks it for its
+//! normalization, target renders, point cloud and initial mesh, and never which kind it is.
 //! A researcher swaps a piece without forking a crate: [`Reconstruction::loss_factory`] builds
-//! the objective from the prepared target, and [`Reconstruction::blocks`] is the remeshing
+//! the objective from what the shape gave, and [`Reconstruction::blocks`] is the remeshing
 //! schedule (any [`Block`]).
 
 pub mod config;
+pub mod soup;
 
 use std::collections::BTreeMap;
 use std::time::Instant;
@@ -22,27 +25,29 @@ use std::time::Instant;
 use glam::DVec3;
 use roar_loss::{
     KnnOptions, KnnPlanarProjector, Loss, LossError, PlanarLoss, PlanarOptions, PointCloud,
-    PointCloudOptions, RenderLoss, SharpEdgeOptions, Target, TargetOptions, WeightedSum,
-    build_target, point_cloud, sharp_edge_samples, two_sided_faces,
+    RenderLoss, Shape, ShapeError, SignedDistance, TargetOptions, WeightedSum,
 };
-use roar_mesh::spatial::{Aabb, Normalization, self_intersecting_faces};
-use roar_mesh::{EdgeId, Mesh};
-use roar_ops::block::{Block, BlockContext, BlockStats};
-use roar_ops::collapse_block::{FaceCollapse, FaceCollapseOptions};
-use roar_ops::data_flips::{DataFlipOptions, flip_toward_target};
-use roar_ops::degenerate::{DegenerateOptions, collapse_degenerate_faces};
-use roar_ops::flips::FlipOptions;
-use roar_ops::geometry::{DEGENERATE_QUALITY, is_degenerate, triangle_quality};
-use roar_ops::init::{InitError, InitOptions, InitialMeshOptions};
+use roar_mesh::Mesh;
+use roar_mesh::spatial::{Normalization, Projector, self_intersecting_faces};
+use roar_ops::blocks::block::{Block, BlockContext, BlockStats};
+use roar_ops::blocks::collapse::{FaceCollapse, FaceCollapseOptions};
+use roar_ops::blocks::flips::FlipOptions;
+use roar_ops::blocks::smoothing::{SmoothingOptions, TangentialSmoothing};
+use roar_ops::blocks::split::{FaceSplit, FaceSplitOptions, SplitThreshold};
+use roar_ops::decimate::{DecimateError, DecimateOptions, DecimateStats, decimate};
+use roar_ops::finish::data_flips::{DataFlipOptions, flip_toward_target};
+use roar_ops::finish::degenerate::{DegenerateOptions, collapse_degenerate_faces};
+use roar_ops::finish::fill::fill_to_budget;
+use roar_ops::finish::offset::offset_outward;
+use roar_ops::finish::slivers::{SliverOptions, flip_slivers};
+use roar_ops::init::InitError;
 use roar_ops::optim::{Optimizer, OptimizerOptions};
-use roar_ops::qem::{DecimateError, DecimateOptions, DecimateStats, decimate};
-use roar_ops::slivers::{SliverOptions, flip_slivers};
-use roar_ops::smoothing::{SmoothingOptions, TangentialSmoothing};
-use roar_ops::split_block::{FaceSplit, FaceSplitOptions, SplitThreshold};
 use roar_ops::untangle::{LimiterOptions, UntangleOptions, UntangleStats, limit_steps, untangle};
+use roar_render::{Camera, Image, star_cameras};
 use serde::Serialize;
 
 pub use config::{InitKind, ReconstructConfig};
+pub use soup::SoupShape;
 
 /// Why a reconstruction failed.
 #[derive(Debug, thiserror::Error)]
@@ -56,6 +61,9 @@ pub enum PipelineError {
     /// The watertight init failed.
     #[error("init: {0}")]
     Init(#[from] InitError),
+    /// The input shape could not give what the pipeline asked for.
+    #[error("{0}")]
+    Shape(#[from] ShapeError),
     /// A mesh that must be a closed manifold is not (a bug in an operator).
     #[error("internal: {0}")]
     Internal(String),
@@ -67,12 +75,17 @@ pub enum PipelineError {
     Intersections(usize),
 }
 
-/// What the pipeline hands to a loss factory.
+/// What the pipeline hands to a loss factory: what the input [`Shape`] gave, in rig
+/// coordinates.
 pub struct Prepared<'a> {
-    /// The cleaned, normalized target and its renders.
-    pub target: &'a Target,
+    /// The camera rig ([`rig_cameras`]).
+    pub cameras: &'a [Camera],
+    /// The shape's target normal map for each camera.
+    pub renders: &'a [Image],
     /// The oriented target point cloud P (with the sharp-edge samples).
     pub cloud: &'a PointCloud,
+    /// The shape's signed distance, if it has one.
+    pub signed_distance: Option<&'a dyn SignedDistance>,
     /// The effective configuration.
     pub config: &'a ReconstructConfig,
 }
@@ -223,11 +236,23 @@ impl Reconstruction {
         }
     }
 
-    /// Runs the whole pipeline on a soup (any coordinates), reporting progress.
-    pub fn run(
+    /// Runs the whole pipeline on a soup (any coordinates): [`Reconstruction::run`] on a
+    /// [`SoupShape`] with this reconstruction's config.
+    pub fn run_soup(
         &mut self,
         positions: &[DVec3],
         triangles: &[[u32; 3]],
+        progress: &mut dyn FnMut(&Progress),
+    ) -> Result<Output, PipelineError> {
+        let mut shape = SoupShape::new("soup", positions, triangles, &self.config);
+        self.run(&mut shape, progress)
+    }
+
+    /// Runs the whole pipeline on `shape` (the [`Shape`] module docs give the order of the
+    /// calls), reporting progress; the output is in the input's coordinates.
+    pub fn run(
+        &mut self,
+        shape: &mut dyn Shape,
         progress: &mut dyn FnMut(&Progress),
     ) -> Result<Output, PipelineError> {
         let config = self.config.clone();
@@ -245,17 +270,26 @@ impl Reconstruction {
         };
 
         report("target", 0, f64::NAN, 0);
-        let target = build_target(positions, triangles, &target_options(&config))?;
-        stats.target_faces = target.triangles.len();
-        stats.twins_dropped = target.stats.twins_dropped;
+        let cameras = rig_cameras(&config);
+        shape.prepare(&cameras)?;
+        let normalization = shape.normalization();
+        let summary = shape.summary();
+        stats.target_faces = summary.target_faces;
+        stats.twins_dropped = summary.twins_dropped;
         clock.lap("target");
 
         report("init", 0, f64::NAN, 0);
-        let mut mesh = initial_mesh(&target, &config, &mut stats)?;
+        let mut mesh = initial_mesh(&*shape, &config, &mut stats)?;
         clock.lap("init");
 
         report("point_cloud", 0, f64::NAN, mesh.n_faces());
-        let cloud = target_cloud(&target, &mesh, &config)?;
+        let cloud = shape.point_cloud(&mesh)?;
+        if cloud.points.is_empty() || cloud.points.len() != cloud.normals.len() {
+            return Err(PipelineError::Loss(LossError::InvalidTarget(format!(
+                "{}: the point cloud is empty or has not one normal per point",
+                shape.name()
+            ))));
+        }
         stats.point_cloud = cloud.points.len();
         clock.lap("point_cloud");
 
@@ -270,11 +304,23 @@ impl Reconstruction {
         }
         clock.lap("working_budget_qem");
 
+        let renders = shape.target_renders(&cameras)?;
+        if renders.len() != cameras.len() {
+            return Err(PipelineError::Loss(LossError::InvalidTarget(format!(
+                "{}: {} target renders for {} cameras",
+                shape.name(),
+                renders.len(),
+                cameras.len()
+            ))));
+        }
         let mut loss = (self.loss_factory)(&Prepared {
-            target: &target,
+            cameras: &cameras,
+            renders: &renders,
             cloud: &cloud,
+            signed_distance: shape.signed_distance(),
             config: &config,
         })?;
+        drop(renders);
         let projector = KnnPlanarProjector::new(
             &cloud.points,
             &cloud.normals,
@@ -283,6 +329,8 @@ impl Reconstruction {
                 ..KnnOptions::default()
             },
         )?;
+        // The Face Split block's scores use the shape's own projector if it has one.
+        let block_projector: &dyn Projector = shape.projector().unwrap_or(&projector);
         let mut optimizer = new_optimizer(&mesh, &config)?;
         // The loop's state and its loss at every checkpoint iteration, to finish from.
         let mut states: Vec<LoopState> = Vec::new();
@@ -319,7 +367,7 @@ impl Reconstruction {
             let context = BlockContext {
                 iteration,
                 face_budget: budget,
-                projector: Some(&projector),
+                projector: Some(block_projector),
             };
             for scheduled in &mut self.blocks {
                 let due = scheduled.every > 0
@@ -371,7 +419,7 @@ impl Reconstruction {
             clock.lap("final_qem");
 
             if config.iterations > 0 && config.final_smoothing_sweeps > 0 {
-                mesh = smooth_if_clean(mesh, &target.normalization, &config, &mut stats);
+                mesh = smooth_if_clean(mesh, &normalization, &config, &mut stats);
                 clock.lap("final_smoothing");
             }
 
@@ -379,7 +427,7 @@ impl Reconstruction {
                 mesh = flip_toward_cloud_if_clean(
                     mesh,
                     &projector,
-                    &target.normalization,
+                    &normalization,
                     &config,
                     &mut stats,
                 );
@@ -392,7 +440,7 @@ impl Reconstruction {
                 mesh = polish(
                     mesh,
                     loss.as_mut(),
-                    &target.normalization,
+                    &normalization,
                     &config,
                     &mut stats,
                     &mut clock,
@@ -401,12 +449,12 @@ impl Reconstruction {
         }
         drop(loss);
         if config.iterations > 0 && config.sliver_quality > 0.0 {
-            mesh = remove_slivers_if_clean(mesh, &target.normalization, &config, &mut stats);
+            mesh = remove_slivers_if_clean(mesh, &normalization, &config, &mut stats);
             clock.lap("sliver_flips");
         }
 
         let (mut out_positions, out_triangles) = mesh.to_triangles();
-        target.normalization.invert_all(&mut out_positions);
+        normalization.invert_all(&mut out_positions);
         stats.seconds = clock.seconds;
         Ok(Output {
             positions: out_positions,
@@ -414,6 +462,17 @@ impl Reconstruction {
             stats,
         })
     }
+}
+
+/// The camera rig of `config` (spec §3.2.1: the star rig, `views_per_axis²` views of
+/// `render_resolution²` pixels), for which every shape renders its target.
+pub fn rig_cameras(config: &ReconstructConfig) -> Vec<Camera> {
+    star_cameras(
+        config.views_per_axis,
+        config.views_per_axis,
+        config.render_resolution,
+        config.render_resolution,
+    )
 }
 
 /// The target renders' options of `config` (spec §3.1, §3.2.1), as the pipeline uses them.
@@ -452,7 +511,7 @@ pub fn default_loss(prepared: &Prepared) -> Result<Box<dyn Loss>, PipelineError>
         WeightedSum::default()
             .with(
                 config.render_weight,
-                Box::new(RenderLoss::new(prepared.target)),
+                Box::new(RenderLoss::from_renders(prepared.cameras, prepared.renders)),
             )
             .with(config.planar_weight, Box::new(planar)),
     ))
@@ -503,26 +562,18 @@ pub fn default_blocks(config: &ReconstructConfig) -> Vec<ScheduledBlock> {
     ]
 }
 
-/// M0: the watertight init of T′ (or an icosphere), decimated to at most `init_max_faces`.
+/// M0: the shape's own initial mesh (for a soup the watertight init of T′, decimated to at
+/// most `init_max_faces`), or an icosphere of radius 0.5 (`init = "sphere"`).
 fn initial_mesh(
-    target: &Target,
+    shape: &dyn Shape,
     config: &ReconstructConfig,
     stats: &mut RunStats,
 ) -> Result<Mesh, PipelineError> {
     let mesh = match config.init {
         InitKind::Watertight => {
-            let options = InitialMeshOptions {
-                init: InitOptions {
-                    resolution: config.init_resolution,
-                    ..InitOptions::default()
-                },
-                max_faces: config.init_max_faces,
-                ..InitialMeshOptions::default()
-            };
-            let (mesh, init_stats) =
-                roar_ops::init::initial_mesh(&target.positions, &target.triangles, &options)?;
-            stats.init_voxel_faces = init_stats.init_faces;
-            mesh
+            let initial = shape.initial_mesh()?;
+            stats.init_voxel_faces = initial.raw_faces;
+            initial.mesh
         }
         InitKind::Sphere => {
             let mut sphere = roar_mesh::shapes::icosphere(config.sphere_level);
@@ -537,49 +588,6 @@ fn initial_mesh(
     stats.init_components = mesh.components().0;
     stats.init_genus = mesh.genus();
     Ok(mesh)
-}
-
-/// P: winding-filtered samples of T′ plus samples on the sharp edges of M0 (spec §3.1 b, c).
-fn target_cloud(
-    target: &Target,
-    m0: &Mesh,
-    config: &ReconstructConfig,
-) -> Result<PointCloud, PipelineError> {
-    let diagonal =
-        Aabb::from_points(target.positions.iter().copied()).map_or(0.0, |b| b.diagonal());
-    let sheet_offset = config.sheet_offset * diagonal;
-    let mut cloud = point_cloud(
-        target,
-        &PointCloudOptions {
-            samples: config.point_cloud_samples,
-            winding_threshold: config.winding_threshold,
-            sheet_offset,
-            seed: config.seed,
-            ..PointCloudOptions::default()
-        },
-    )?;
-    if config.sharp_edge_samples > 0 {
-        let (positions, triangles) = m0.to_triangles();
-        let sharp = sharp_edge_samples(
-            &target.bvh(),
-            &two_sided_faces(&target.triangles),
-            &positions,
-            &triangles,
-            &SharpEdgeOptions {
-                samples: config.sharp_edge_samples,
-                sheet_offset,
-                seed: config.seed,
-                ..SharpEdgeOptions::default()
-            },
-        )?;
-        cloud.extend(sharp);
-    }
-    if cloud.points.is_empty() {
-        return Err(PipelineError::Loss(LossError::InvalidTarget(
-            "no target sample survived the winding-number filter".into(),
-        )));
-    }
-    Ok(cloud)
 }
 
 /// A fresh optimizer for `mesh` with the configured learning rate and Laplacian weight.
@@ -683,8 +691,8 @@ fn polish(
     Ok(if clean { best } else { mesh })
 }
 
-/// The sliver flips of `roar_ops::slivers` on the final mesh; then, for the degenerate faces
-/// they leave, the collapses of `roar_ops::degenerate`, the face count restored by edge splits
+/// The sliver flips of `roar_ops::finish::slivers` on the final mesh; then, for the degenerate faces
+/// they leave, the collapses of `roar_ops::finish::degenerate`, the face count restored by edge splits
 /// ([`fill_to_budget`], which moves no geometry), and the flips once more. Kept only if the result is
 /// free of self-intersections in the input's coordinates, where it will be written (everything
 /// is checked exactly in the normalized ones; undoing the normalization rounds).
@@ -694,24 +702,43 @@ fn remove_slivers_if_clean(
     config: &ReconstructConfig,
     stats: &mut RunStats,
 ) -> Mesh {
-    let mut cleaned = mesh.clone();
     let options = SliverOptions {
         max_quality: config.sliver_quality,
         ..SliverOptions::default()
     };
-    let mut flips = flip_slivers(&mut cleaned, &options).accepted;
-    let faces = cleaned.n_faces();
-    let collapses = collapse_degenerate_faces(&mut cleaned, &DegenerateOptions::default()).accepted;
-    if collapses > 0 {
-        fill_to_budget(&mut cleaned, faces);
-        flips += flip_slivers(&mut cleaned, &options).accepted;
+    let (mut flips, mut collapses) = (0, 0);
+    let (mesh, changes) = keep_if_clean(mesh, normalization, |cleaned| {
+        flips = flip_slivers(cleaned, &options).accepted;
+        let faces = cleaned.n_faces();
+        collapses = collapse_degenerate_faces(cleaned, &DegenerateOptions::default()).accepted;
+        if collapses > 0 {
+            fill_to_budget(cleaned, faces);
+            flips += flip_slivers(cleaned, &options).accepted;
+        }
+        flips + collapses
+    });
+    if changes > 0 {
+        stats.sliver_flips = flips;
+        stats.degenerate_collapses = collapses;
     }
-    if flips + collapses == 0 || !clean_in_output_coordinates(&cleaned, normalization) {
-        return mesh;
+    mesh
+}
+
+/// The finish's one pattern for a step that must not make the output intersect itself: runs
+/// `step` on a copy of `mesh` (`step` returns how many changes it made) and returns the copy
+/// and that count if it is positive and the copy is free of self-intersections in the input's
+/// coordinates ([`clean_in_output_coordinates`]); otherwise `mesh` as it was and 0.
+fn keep_if_clean(
+    mesh: Mesh,
+    normalization: &Normalization,
+    step: impl FnOnce(&mut Mesh) -> usize,
+) -> (Mesh, usize) {
+    let mut changed = mesh.clone();
+    let changes = step(&mut changed);
+    if changes == 0 || !clean_in_output_coordinates(&changed, normalization) {
+        return (mesh, 0);
     }
-    stats.sliver_flips = flips;
-    stats.degenerate_collapses = collapses;
-    cleaned
+    (changed, changes)
 }
 
 /// Whether `mesh`, with the normalization undone (as it will be written), is free of
@@ -726,58 +753,12 @@ fn clean_in_output_coordinates(mesh: &Mesh, normalization: &Normalization) -> bo
 /// The triangles of a compact mesh (compacting it, and the optimizer with it, if needed).
 fn compact_triangles(mesh: &mut Mesh, optimizer: &mut Optimizer) -> Vec<[u32; 3]> {
     if mesh.vertex_capacity() != mesh.n_vertices() || mesh.face_capacity() != mesh.n_faces() {
-        roar_ops::block::compact_with_optimizer(mesh, optimizer);
+        roar_ops::optim::compact_with_optimizer(mesh, optimizer);
     }
-    roar_ops::block::sync_optimizer_len(mesh, optimizer);
+    roar_ops::optim::sync_optimizer_len(mesh, optimizer);
     mesh.faces()
         .map(|f| mesh.face_vertices(f).map(|v| v.raw()))
         .collect()
-}
-
-/// Splits edges at their midpoints until the mesh has `faces` faces (each split adds two),
-/// longest first, skipping edges whose halving would leave a degenerate face
-/// ([`bisects_well`]): halving a needle's long edge leaves two needles and halving a flat
-/// cap's edge can make a flatter one, which would undo the degenerate collapses this fill
-/// follows. When no edge qualifies the longest is split anyway, so the fill always ends. The
-/// geometry does not change, so no intersection can appear. Returns the split count.
-fn fill_to_budget(mesh: &mut Mesh, faces: usize) -> usize {
-    let mut splits = 0;
-    while mesh.n_faces() < faces {
-        let mut edges: Vec<(f64, EdgeId)> = mesh
-            .edges()
-            .filter(|&e| bisects_well(mesh, e))
-            .map(|e| (mesh.edge_length(e), e))
-            .collect();
-        if edges.is_empty() {
-            edges = mesh.edges().map(|e| (mesh.edge_length(e), e)).collect();
-        }
-        // Longest first; ties by id keep it deterministic.
-        edges.sort_by(|a, b| b.0.total_cmp(&a.0).then(a.1.cmp(&b.1)));
-        let wanted = (faces - mesh.n_faces()) / 2;
-        for &(_, e) in edges.iter().take(wanted.max(1)) {
-            if mesh.n_faces() >= faces {
-                break;
-            }
-            mesh.split_edge(e, 0.5);
-            splits += 1;
-        }
-    }
-    mesh.compact();
-    splits
-}
-
-/// Whether halving `e` leaves no degenerate face ([`DEGENERATE_QUALITY`]): neither face of `e`
-/// is degenerate, nor is any of the four faces the split would make (see [`fill_to_budget`]).
-fn bisects_well(mesh: &Mesh, e: EdgeId) -> bool {
-    let h = mesh.edge_halfedge(e);
-    [h, h.twin()].into_iter().all(|h| {
-        let (a, b) = (mesh.position(mesh.tail(h)), mesh.position(mesh.head(h)));
-        let c = mesh.position(mesh.head(mesh.next(h)));
-        let m = 0.5 * (a + b);
-        [[a, b, c], [a, m, c], [m, b, c]]
-            .into_iter()
-            .all(|t| !is_degenerate(triangle_quality(t), DEGENERATE_QUALITY))
-    })
 }
 
 /// Fills the mesh up to `config.faces`, runs the untangle block and fills again (its collapses
@@ -811,15 +792,13 @@ fn smooth_if_clean(
         guard_intersections: true,
         ..SmoothingOptions::default()
     };
-    let mut smoothed = mesh.clone();
-    let moves: usize = (0..config.final_smoothing_sweeps)
-        .map(|_| roar_ops::smoothing::tangential_smoothing(&mut smoothed, &options).accepted)
-        .sum();
-    if moves == 0 || !clean_in_output_coordinates(&smoothed, normalization) {
-        return mesh;
-    }
+    let (mesh, moves) = keep_if_clean(mesh, normalization, |smoothed| {
+        (0..config.final_smoothing_sweeps)
+            .map(|_| roar_ops::blocks::smoothing::tangential_smoothing(smoothed, &options).accepted)
+            .sum()
+    });
     stats.final_smoothing_moves += moves;
-    smoothed
+    mesh
 }
 
 /// `config.data_flip_rounds` rounds of data-dependent flips toward the normals of the point cloud
@@ -842,43 +821,11 @@ fn flip_toward_cloud_if_clean(
         max_rounds: config.data_flip_rounds,
         ..DataFlipOptions::default()
     };
-    let mut flipped = mesh.clone();
-    let flips = flip_toward_target(&mut flipped, &target_normal, &options).accepted;
-    if flips == 0 || !clean_in_output_coordinates(&flipped, normalization) {
-        return mesh;
-    }
+    let (mesh, flips) = keep_if_clean(mesh, normalization, |flipped| {
+        flip_toward_target(flipped, &target_normal, &options).accepted
+    });
     stats.data_flips += flips;
-    flipped
-}
-
-/// Moves every vertex `relative × diagonal` outward along its normal, each move shortened or
-/// cancelled where it would make faces intersect; returns how many vertices moved the whole way.
-///
-/// Why: the optimization pulls the two sides of a thin part (and of an open surface, which the
-/// init wraps from both sides) onto the same sheet, closer than any chord the final QEM makes,
-/// so its self-intersection veto refuses nearly every collapse there and the decimation eats
-/// the part from its rim instead. Offset apart, the two sides decimate like any other surface;
-/// the polish then moves the vertices back onto the target.
-fn offset_outward(mesh: &mut Mesh, relative: f64) -> usize {
-    // Compact, the mesh's vertex ids are the indices of `to_triangles`.
-    mesh.compact();
-    let (positions, triangles) = mesh.to_triangles();
-    let diagonal = Aabb::from_points(positions.iter().copied()).map_or(0.0, |b| b.diagonal());
-    let distance = relative * diagonal;
-    let normals = roar_loss::planar::vertex_normals(&positions, &triangles);
-    let mut moved: Vec<DVec3> = positions
-        .iter()
-        .zip(&normals)
-        .map(|(&p, &n)| p + distance * n)
-        .collect();
-    let limited = limit_steps(
-        &positions,
-        &mut moved,
-        &triangles,
-        &LimiterOptions::default(),
-    );
-    mesh.positions_mut().copy_from_slice(&moved);
-    positions.len() - limited.shortened - limited.cancelled
+    mesh
 }
 
 /// The face counts the finish decimates to, each followed by a polish: `[2N, N]` when the
@@ -1002,8 +949,12 @@ impl StageClock {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use roar_mesh::EdgeId;
     use roar_mesh::shapes::icosphere;
+    use roar_mesh::spatial::Aabb;
     use roar_mesh::spatial::count_intersecting_faces;
+    use roar_ops::finish::fill::bisects_well;
+    use roar_ops::geometry::{DEGENERATE_QUALITY, is_degenerate, triangle_quality};
 
     /// Faces at or above [`DEGENERATE_QUALITY`].
     fn degenerate_faces(mesh: &Mesh) -> usize {

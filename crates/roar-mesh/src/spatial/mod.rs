@@ -13,7 +13,8 @@
 //! [`tri_tri`] (exact triangle–triangle tests), [`self_intersections`], [`sampling`]
 //! (area-weighted random samples),
 //! [`winding`] (fast winding numbers), [`regular_sampling`] (regular per-face grids),
-//! [`projector`] (the `Projector` trait), [`ray_projector`] (exact ray-cast projection, §3.4 (B)).
+//! [`projector`] (the `Projector` trait), [`ray_projector`] (exact ray-cast projection, §3.4 (B)),
+//! [`vertex_normals`](mod@vertex_normals) (the ROAR vertex normals, §2.2).
 
 pub mod aabb;
 pub mod bvh;
@@ -25,6 +26,7 @@ pub mod regular_sampling;
 pub mod sampling;
 pub mod self_intersections;
 pub mod tri_tri;
+pub mod vertex_normals;
 pub mod winding;
 
 pub use aabb::Aabb;
@@ -42,6 +44,7 @@ pub use self_intersections::{
     count_intersecting_faces, face_intersects_any, intersecting_pairs, self_intersecting_faces,
 };
 pub use tri_tri::{faces_intersect, segment_intersects_triangle, triangles_intersect};
+pub use vertex_normals::vertex_normals;
 pub use winding::{
     TriangleIndexError, WindingNumber, WindingNumberOptions, exact_winding_number,
     triangle_solid_angle,

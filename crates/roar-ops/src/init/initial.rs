@@ -1,7 +1,7 @@
 //! The pipeline's initial mesh (spec §4.1: watertight init, then QEM to at most 20k faces).
 
 use super::{InitError, InitOptions, InitStats, WatertightInit, watertight_init};
-use crate::qem::{DecimateOptions, DecimateStats, decimate_in_parallel, minimum_faces};
+use crate::decimate::{DecimateOptions, DecimateStats, decimate_in_parallel, minimum_faces};
 use glam::DVec3;
 use roar_mesh::Mesh;
 use std::time::Instant;

@@ -18,7 +18,35 @@
 //! added with `grow`. Removed vertices keep their (stale) rows until `apply_remap` drops them;
 //! `step` ignores them meanwhile because no triangle references them.
 
+use roar_mesh::Mesh;
+
 use super::{OptimError, Optimizer, VertexState};
+
+/// Gives the optimizer a row for every vertex slot of the mesh (new rows are zero), so the
+/// transfer calls of a block always find their rows.
+pub fn sync_optimizer_len(mesh: &Mesh, optimizer: &mut Optimizer) {
+    optimizer.grow(mesh.vertex_capacity());
+}
+
+/// Compacts the mesh and applies the vertex remap to the optimizer rows. Rows beyond the old
+/// vertex capacity (none if [`sync_optimizer_len`] ran) are dropped. Afterwards
+/// `optimizer.len() == mesh.vertex_capacity() == mesh.n_vertices()`.
+pub fn compact_with_optimizer(mesh: &mut Mesh, optimizer: &mut Optimizer) {
+    sync_optimizer_len(mesh, optimizer);
+    let remap = mesh.compact();
+    let mut old_to_new: Vec<u32> = remap
+        .vertices
+        .iter()
+        .map(|v| v.map_or(u32::MAX, |v| v.raw()))
+        .collect();
+    old_to_new.resize(optimizer.len(), u32::MAX);
+    optimizer
+        .apply_remap(&old_to_new)
+        .expect("a mesh compaction remap is injective and sized to the optimizer (invariant)");
+    // Live vertices all map somewhere; if the mesh's last slots were dead the optimizer may be
+    // shorter than the new capacity only when nothing maps there, which cannot happen.
+    sync_optimizer_len(mesh, optimizer);
+}
 
 impl Optimizer {
     /// Edge collapse (spec §3.12): the survivor's row becomes the row of `row_source`, the

@@ -14,7 +14,7 @@
 //! from a short list with their current corners. Every test is
 //! [`crate::intersect::faces_intersect_filtered`], exact behind certified filters.
 
-use crate::block::BlockStats;
+use crate::blocks::block::BlockStats;
 use crate::intersect::faces_intersect_filtered;
 use glam::DVec3;
 use roar_mesh::spatial::{Aabb, TriangleBvh};

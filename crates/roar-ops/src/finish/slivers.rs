@@ -32,11 +32,11 @@
 //!
 //! Edges are visited in id order, rounds repeat until a round flips nothing (or `max_rounds`).
 
-use crate::block::BlockStats;
+use crate::blocks::block::BlockStats;
+use crate::blocks::guard::{IntersectionGuard, flip_if_clean};
 use crate::geometry::{
     flip_keeps_orientation, flip_quad, is_degenerate, triangle_normal, triangle_quality,
 };
-use crate::guard::{IntersectionGuard, flip_if_clean};
 use glam::DVec3;
 use roar_mesh::Mesh;
 
@@ -50,7 +50,7 @@ pub struct SliverOptions {
     pub min_abs_flatness: f64,
     /// A face with `Q` at or above this is degenerate: its normal is not trusted, and the flat
     /// test looks at the other face only (module doc, test 2). Default 100, the QEM's
-    /// [`crate::qem::DecimateOptions::degenerate_quality`]. Without it, the caps the
+    /// [`crate::decimate::DecimateOptions::degenerate_quality`]. Without it, the caps the
     /// optimization leaves along creases were nearly all refused by the flat test (on roar's
     /// 5000-face output of luke-f-16: 61 of 95 candidates refused as not flat, 12 for the
     /// orientation, none flipped).

@@ -1,5 +1,5 @@
 //! Degenerate-face collapses for a finished mesh: remove a face with aspect ratio above a limit
-//! by collapsing one of its edges, when no flip can (see [`crate::slivers`]).
+//! by collapsing one of its edges, when no flip can (see [`crate::finish::slivers`]).
 //!
 //! A sliver flip fixes a cap whose long edge has a good face across it. It cannot fix a needle
 //! (a very short edge: flipping a long edge leaves the short one), nor a cap whose neighbour
@@ -32,9 +32,9 @@
 //! collapse removes two faces; the caller restores the face count (the pipeline splits edges
 //! whose halves are not degenerate, longest first, which moves no geometry).
 
-use crate::block::BlockStats;
+use crate::blocks::block::BlockStats;
+use crate::blocks::guard::IntersectionGuard;
 use crate::geometry::{DEGENERATE_QUALITY, is_degenerate, triangle_normal, triangle_quality};
-use crate::guard::IntersectionGuard;
 use roar_mesh::{FaceId, HalfedgeId, Mesh};
 
 /// Options of [`collapse_degenerate_faces`].
@@ -42,7 +42,7 @@ use roar_mesh::{FaceId, HalfedgeId, Mesh};
 pub struct DegenerateOptions {
     /// Faces with `Q = R/(2r)` at or above this (or NaN, fully collapsed) are degenerate.
     /// Default [`DEGENERATE_QUALITY`] (100), as the QEM's
-    /// [`crate::qem::DecimateOptions::degenerate_quality`].
+    /// [`crate::decimate::DecimateOptions::degenerate_quality`].
     pub min_quality: f64,
     /// Every reshaped face that was not degenerate keeps `n_new · n_old ≥` this. Default 0.95
     /// (the flat test of the sliver flips).

@@ -5,22 +5,21 @@
 //!    Optional gate (off here, on in the pipeline): skip faces whose `|n_o(f)| = |Σ n_vk| / 3`
 //!    is below 0.98 (creases, thin parts), unless they fold back onto a neighbour.
 //! 2. Candidate edges: the edges of flagged faces, priority `exp(−|e|)`.
-//! 3. Validity: the QSlim collapse simulation ([`crate::qslim::edge_cost`]); no incident face may
+//! 3. Validity: the QSlim collapse simulation ([`crate::blocks::qslim::edge_cost`]); no incident face may
 //!    flip, and optionally (off for fold removal) no resulting face may have `Q > 5`. An edge
 //!    with no valid placement drops out; otherwise the placement with lower QSlim cost decides
 //!    which endpoint survives.
 //! 4. Independent selection (§3.11), collapse (the survivor keeps the chosen endpoint's position
 //!    and optimizer row), compact, then flips.
 
-use crate::block::{
-    Block, BlockContext, BlockStats, apply_collapse, compact_with_optimizer, sync_optimizer_len,
-};
-use crate::flips::{FlipOptions, flip_edges};
+use crate::blocks::block::{Block, BlockContext, BlockStats};
+use crate::blocks::flips::{FlipOptions, flip_edges};
+use crate::blocks::guard::IntersectionGuard;
+use crate::blocks::qslim::{EdgeCost, QSlimOptions, ValidityOptions, edge_cost, vertex_quadrics};
+use crate::blocks::select::{SelectOptions, select_independent_edges};
 use crate::geometry::Geometry;
-use crate::guard::IntersectionGuard;
 use crate::optim::Optimizer;
-use crate::qslim::{EdgeCost, QSlimOptions, ValidityOptions, edge_cost, vertex_quadrics};
-use crate::select::{SelectOptions, select_independent_edges};
+use crate::optim::{compact_with_optimizer, sync_optimizer_len};
 use roar_mesh::Mesh;
 
 /// Options of [`face_collapse`] (spec §3.6, note 4).
@@ -192,4 +191,42 @@ impl Block for FaceCollapse {
     ) -> BlockStats {
         face_collapse(mesh, optimizer, &self.options)
     }
+}
+
+/// Applies the collapse `c` chosen by a block: the mesh merges `c.halfedge`'s tail into `c.keep`
+/// (which keeps its position), and the optimizer row of `c.keep` survives. With a `guard`, a
+/// collapse that would make a face intersect another one is skipped and counted as
+/// `rejected["intersection"]`; a collapse the link condition refuses (an earlier collapse of the
+/// block changed the neighbourhood) as `rejected["link"]`. Returns whether it was applied.
+pub fn apply_collapse(
+    mesh: &mut Mesh,
+    optimizer: &mut Optimizer,
+    c: &EdgeCost,
+    mut guard: Option<&mut IntersectionGuard>,
+    stats: &mut BlockStats,
+) -> bool {
+    if mesh.can_collapse(c.halfedge).is_err() {
+        stats.reject("link", 1);
+        return false;
+    }
+    if let Some(guard) = guard.as_deref_mut() {
+        let p = mesh.position(c.keep);
+        if guard.collapse_intersects(mesh, c.halfedge, p) {
+            stats.reject("intersection", 1);
+            return false;
+        }
+    }
+    let out = mesh
+        .collapse(c.halfedge)
+        .expect("can_collapse passed just before (invariant)");
+    optimizer
+        .on_collapse(out.survivor.raw(), c.keep.raw())
+        .expect("optimizer rows cover every vertex slot (invariant)");
+    if let Some(guard) = guard {
+        for f in out.removed_faces {
+            guard.mark(f);
+        }
+        guard.mark_around(mesh, out.survivor);
+    }
+    true
 }

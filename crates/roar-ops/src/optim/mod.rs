@@ -43,6 +43,8 @@
 mod adjacency;
 mod transfer;
 
+pub use transfer::{compact_with_optimizer, sync_optimizer_len};
+
 use adjacency::VertexAdjacency;
 use glam::DVec3;
 use rayon::prelude::*;

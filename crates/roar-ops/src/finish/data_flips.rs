@@ -37,9 +37,9 @@
 //! longer exist). Every flip lowers the total error, so the process ends; `max_rounds` bounds the
 //! work.
 
-use crate::block::BlockStats;
+use crate::blocks::block::BlockStats;
+use crate::blocks::guard::{IntersectionGuard, flip_if_clean};
 use crate::geometry::{flip_keeps_orientation, flip_quad, triangle_quality};
-use crate::guard::{IntersectionGuard, flip_if_clean};
 use glam::DVec3;
 use rayon::prelude::*;
 use roar_mesh::{EdgeId, Mesh};

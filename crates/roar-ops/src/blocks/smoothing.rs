@@ -16,7 +16,7 @@
 //! sweep, climbed from 0.011 at iteration 20 to 0.064 at 200, and the output's Chamfer/diag was
 //! 2.71e-3 with the sweeps and 1.84e-3 with none.
 
-use crate::block::{Block, BlockContext, BlockStats};
+use crate::blocks::block::{Block, BlockContext, BlockStats};
 use crate::geometry::Geometry;
 use crate::optim::Optimizer;
 use crate::untangle::{LimiterOptions, limit_steps};
@@ -133,7 +133,7 @@ impl Block for TangentialSmoothing {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::qem::triangle_quality;
+    use crate::decimate::triangle_quality;
     use roar_mesh::shapes::icosphere;
 
     /// An icosphere whose vertices slid along the sphere by up to `amount` of the radius, so

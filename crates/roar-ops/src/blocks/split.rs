@@ -15,17 +15,17 @@
 //! 4. Pairing and budget (§3.8 steps 6–7, note 8), then collapses, then 1→3 centroid splits
 //!    (the new vertex gets the mean optimizer row), then compaction.
 
-use crate::block::{
-    Block, BlockContext, BlockStats, apply_collapse, compact_with_optimizer, sync_optimizer_len,
-};
-use crate::geometry::Geometry;
-use crate::guard::IntersectionGuard;
-use crate::optim::Optimizer;
-use crate::qslim::{
+use crate::blocks::block::{Block, BlockContext, BlockStats};
+use crate::blocks::collapse::apply_collapse;
+use crate::blocks::guard::IntersectionGuard;
+use crate::blocks::qslim::{
     EdgeCost, QSlimOptions, Quadric, ValidityOptions, edge_cost, edge_cost_lower_bound,
     vertex_quadrics,
 };
-use crate::select::{SelectOptions, Selection, select_independent_edges};
+use crate::blocks::select::{SelectOptions, Selection, select_independent_edges};
+use crate::geometry::Geometry;
+use crate::optim::Optimizer;
+use crate::optim::{compact_with_optimizer, sync_optimizer_len};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;

@@ -15,9 +15,9 @@
 //! [INF: the 2000 cap applies to the edges passing the tests, so a large mesh is not stuck on
 //! its first 2000 edges.]
 
-use crate::block::{Block, BlockContext, BlockStats};
+use crate::blocks::block::{Block, BlockContext, BlockStats};
+use crate::blocks::guard::IntersectionGuard;
 use crate::geometry::triangle_normal;
-use crate::guard::IntersectionGuard;
 use crate::optim::Optimizer;
 use roar_mesh::{EdgeId, Mesh};
 

@@ -1,0 +1,176 @@
+//! The triangle soup as a [`Shape`]: the input kind `roar reconstruct` reads from OBJ, PLY, STL
+//! and OFF files.
+//!
+//! [`SoupShape::prepare`] builds the cleaned target T′ (weld, normalize, twin clean-up by pixel
+//! counts; `roar_loss::target`) and its renders; the initial mesh is the watertight voxel init
+//! of T′ decimated to `init_max_faces` (`roar_ops::init`); the point cloud is the
+//! winding-filtered samples of T′ plus samples on the sharp edges of M0 (spec §3.1 b, c).
+
+use std::borrow::Cow;
+
+use glam::DVec3;
+use roar_loss::{
+    InitialMesh, LossError, PointCloud, PointCloudOptions, Shape, ShapeError, ShapeSummary,
+    SharpEdgeOptions, Target, build_target, point_cloud, render_views, sharp_edge_samples,
+    two_sided_faces,
+};
+use roar_mesh::Mesh;
+use roar_mesh::spatial::{Aabb, Normalization};
+use roar_ops::init::{InitOptions, InitialMeshOptions};
+use roar_render::{Camera, Image};
+
+use super::{ReconstructConfig, target_options};
+
+/// A triangle soup (any coordinates, anything goes) and the configuration it is cleaned up,
+/// initialised and sampled with.
+pub struct SoupShape<'a> {
+    name: String,
+    positions: &'a [DVec3],
+    triangles: &'a [[u32; 3]],
+    config: ReconstructConfig,
+    /// T′ and its renders, made by [`Shape::prepare`].
+    target: Option<Target>,
+}
+
+impl<'a> SoupShape<'a> {
+    /// The soup `positions` (#V) and `triangles` (#F indices into `positions`), unchecked until
+    /// [`Shape::prepare`], which reports an out-of-range index or a non-finite coordinate.
+    pub fn new(
+        name: impl Into<String>,
+        positions: &'a [DVec3],
+        triangles: &'a [[u32; 3]],
+        config: &ReconstructConfig,
+    ) -> Self {
+        Self {
+            name: name.into(),
+            positions,
+            triangles,
+            config: config.clone(),
+            target: None,
+        }
+    }
+
+    /// The cleaned target T′, once prepared.
+    pub fn target(&self) -> Option<&Target> {
+        self.target.as_ref()
+    }
+
+    fn prepared(&self) -> Result<&Target, ShapeError> {
+        self.target.as_ref().ok_or_else(|| {
+            ShapeError::Loss(LossError::InvalidTarget(
+                "the soup was used before `prepare`".into(),
+            ))
+        })
+    }
+}
+
+impl Shape for SoupShape<'_> {
+    fn name(&self) -> &str {
+        &self.name
+    }
+
+    /// Builds T′ with the configured clean-up rig (`views_per_axis`, `render_resolution`,
+    /// `twin_ratio`); its target renders are rendered again only if `cameras` is another rig.
+    fn prepare(&mut self, cameras: &[Camera]) -> Result<(), ShapeError> {
+        let mut target = build_target(
+            self.positions,
+            self.triangles,
+            &target_options(&self.config),
+        )?;
+        if target.cameras != cameras {
+            target.renders = render_views(&target.positions, &target.triangles, cameras, true)?;
+            target.cameras = cameras.to_vec();
+        }
+        self.target = Some(target);
+        Ok(())
+    }
+
+    /// The normalization of T′ (identity before [`Shape::prepare`]).
+    fn normalization(&self) -> Normalization {
+        self.target
+            .as_ref()
+            .map_or(Normalization::IDENTITY, |t| t.normalization)
+    }
+
+    fn initial_mesh(&self) -> Result<InitialMesh, ShapeError> {
+        let target = self.prepared()?;
+        let options = InitialMeshOptions {
+            init: InitOptions {
+                resolution: self.config.init_resolution,
+                ..InitOptions::default()
+            },
+            max_faces: self.config.init_max_faces,
+            ..InitialMeshOptions::default()
+        };
+        let (mesh, stats) =
+            roar_ops::init::initial_mesh(&target.positions, &target.triangles, &options)
+                .map_err(|e| ShapeError::Init(e.to_string()))?;
+        Ok(InitialMesh {
+            mesh,
+            raw_faces: stats.init_faces,
+        })
+    }
+
+    fn point_cloud(&self, initial: &Mesh) -> Result<PointCloud, ShapeError> {
+        let target = self.prepared()?;
+        let config = &self.config;
+        let diagonal =
+            Aabb::from_points(target.positions.iter().copied()).map_or(0.0, |b| b.diagonal());
+        let sheet_offset = config.sheet_offset * diagonal;
+        let mut cloud = point_cloud(
+            target,
+            &PointCloudOptions {
+                samples: config.point_cloud_samples,
+                winding_threshold: config.winding_threshold,
+                sheet_offset,
+                seed: config.seed,
+                ..PointCloudOptions::default()
+            },
+        )?;
+        if config.sharp_edge_samples > 0 {
+            let (positions, triangles) = initial.to_triangles();
+            let sharp = sharp_edge_samples(
+                &target.bvh(),
+                &two_sided_faces(&target.triangles),
+                &positions,
+                &triangles,
+                &SharpEdgeOptions {
+                    samples: config.sharp_edge_samples,
+                    sheet_offset,
+                    seed: config.seed,
+                    ..SharpEdgeOptions::default()
+                },
+            )?;
+            cloud.extend(sharp);
+        }
+        if cloud.points.is_empty() {
+            return Err(ShapeError::Loss(LossError::InvalidTarget(
+                "no target sample survived the winding-number filter".into(),
+            )));
+        }
+        Ok(cloud)
+    }
+
+    fn target_renders(&self, cameras: &[Camera]) -> Result<Cow<'_, [Image]>, ShapeError> {
+        let target = self.prepared()?;
+        if target.cameras == cameras {
+            Ok(Cow::Borrowed(&target.renders))
+        } else {
+            Ok(Cow::Owned(render_views(
+                &target.positions,
+                &target.triangles,
+                cameras,
+                true,
+            )?))
+        }
+    }
+
+    fn summary(&self) -> ShapeSummary {
+        self.target
+            .as_ref()
+            .map_or_else(ShapeSummary::default, |t| ShapeSummary {
+                target_faces: t.triangles.len(),
+                twins_dropped: t.stats.twins_dropped,
+            })
+    }
+}

@@ -1,0 +1,125 @@
+//! The [`Shape`] seam: what the reconstruction pipeline needs from an input, whatever kind it is
+//! (a triangle soup, a signed distance function, a set of range scans).
+//!
+//! The pipeline asks a shape, in this order:
+//! 1. [`Shape::prepare`] once, with the camera rig: the place for costly set-up (a soup cleans
+//!    itself up and renders its target here);
+//! 2. [`Shape::normalization`]: the map from the input's coordinates into the rig's sphere;
+//! 3. [`Shape::initial_mesh`]: a closed mesh M0 to start from;
+//! 4. [`Shape::point_cloud`]: the oriented target samples P, given M0 (for sharp-feature samples);
+//! 5. [`Shape::target_renders`]: one normal map per camera of the rig;
+//! 6. [`Shape::signed_distance`] and [`Shape::projector`]: what else it offers the losses and
+//!    the Face Split block.
+//!
+//! Every geometric quantity a shape returns (meshes, points, normals, renders) is in **rig
+//! coordinates**: the input's coordinates mapped by [`Shape::normalization`], inside the sphere
+//! of radius [`roar_mesh::spatial::RIG_RADIUS`] the cameras look at. The pipeline maps its output
+//! back with the same normalization. Normals point **outward**, out of the solid the shape
+//! bounds, and triangles are ordered counter-clockwise seen from outside.
+
+use std::borrow::Cow;
+
+use glam::DVec3;
+use roar_mesh::Mesh;
+use roar_mesh::spatial::{Normalization, Projector};
+use roar_render::{Camera, Image};
+
+use crate::{LossError, PointCloud};
+
+/// Why a shape could not give what the pipeline asked for.
+#[derive(Debug, thiserror::Error)]
+pub enum ShapeError {
+    /// A target, a render or a sample set could not be made.
+    #[error("{0}")]
+    Loss(#[from] LossError),
+    /// No initial mesh could be made.
+    #[error("init: {0}")]
+    Init(String),
+}
+
+/// The initial closed mesh M0 of a shape, with how many faces it had before any decimation.
+#[derive(Clone, Debug)]
+pub struct InitialMesh {
+    /// A closed, oriented 2-manifold in rig coordinates.
+    pub mesh: Mesh,
+    /// Faces of the shape's raw init before it was decimated (the voxel surface of a soup's
+    /// watertight init; `mesh.n_faces()` when nothing was decimated). For reports.
+    pub raw_faces: usize,
+}
+
+/// Figures about a shape's own preparation, for reports (zeros where a kind has no such thing).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct ShapeSummary {
+    /// Faces of the prepared target surface (a soup's cleaned T′).
+    pub target_faces: usize,
+    /// Inward twins a soup's clean-up dropped.
+    pub twins_dropped: usize,
+}
+
+/// A signed distance `f` with its gradient, evaluated in batches: negative inside the solid,
+/// positive outside, zero on the surface, in rig coordinates.
+///
+/// This is the slot the SDF losses and projectors plug into; implementations must be
+/// deterministic and may evaluate a batch in parallel.
+pub trait SignedDistance: Sync {
+    /// Writes `f(p)` into `values[i]` and `∇f(p)` into `gradients[i]` for every `points[i]`.
+    /// The three slices have the same length.
+    fn evaluate(&self, points: &[DVec3], values: &mut [f64], gradients: &mut [DVec3]);
+}
+
+/// One kind of input, as the reconstruction pipeline sees it (module docs: order of calls,
+/// coordinates and orientation).
+///
+/// A shape may cache anything it computes: the pipeline calls [`Shape::prepare`] once and every
+/// other method but [`Shape::name`] at most once per run, so what a method costs is paid once
+/// (and [`Shape::initial_mesh`] not at all when the config asks for the sphere init); the costs
+/// below are those of the soup implementation.
+pub trait Shape {
+    /// A short name for reports and messages (e.g. the input's file name).
+    fn name(&self) -> &str;
+
+    /// Set-up before any other call, for the pipeline's camera rig (the same `cameras` are later
+    /// passed to [`Shape::target_renders`]). The default does nothing. A soup welds, normalizes
+    /// and cleans itself up here (renders from its own clean-up rig, then the target renders):
+    /// the costliest step of a shape, seconds at the default 36 views of 512².
+    fn prepare(&mut self, cameras: &[Camera]) -> Result<(), ShapeError> {
+        let _ = cameras;
+        Ok(())
+    }
+
+    /// The map from the input's coordinates into rig coordinates: it puts the shape's bounds
+    /// into the rig's sphere ([`Normalization::fit`] does so for a vertex set). Cheap; called
+    /// after [`Shape::prepare`]; the pipeline inverts it on its output.
+    fn normalization(&self) -> Normalization;
+
+    /// The initial closed, oriented 2-manifold M0 in rig coordinates, enclosing what the shape
+    /// encloses (a soup: its watertight voxel init, decimated; seconds).
+    fn initial_mesh(&self) -> Result<InitialMesh, ShapeError>;
+
+    /// The oriented target point cloud P in rig coordinates (unit outward normals), including
+    /// samples on sharp features; `initial` is M0, whose sharp edges a soup samples. Must not be
+    /// empty. Seconds for a soup's 200k samples with their winding-number filter.
+    fn point_cloud(&self, initial: &Mesh) -> Result<PointCloud, ShapeError>;
+
+    /// One flat-shaded normal map of the shape per camera, in the order of `cameras`, as
+    /// `roar_loss::render_views` makes them for a mesh (RGB the outward unit normal, alpha the
+    /// coverage; culling on). Borrowed when the shape already holds them (a soup renders them in
+    /// [`Shape::prepare`]); each image is `width × height` of its camera.
+    fn target_renders(&self, cameras: &[Camera]) -> Result<Cow<'_, [Image]>, ShapeError>;
+
+    /// The shape's signed distance, if it has one (SDF inputs do; a soup does not).
+    fn signed_distance(&self) -> Option<&dyn SignedDistance> {
+        None
+    }
+
+    /// A projector onto the shape for the Face Split block's scores, if the shape has a better
+    /// one than the default k-NN planar projection over [`Shape::point_cloud`].
+    fn projector(&self) -> Option<&dyn Projector> {
+        None
+    }
+
+    /// Figures about the preparation, for reports (default: zeros).
+    fn summary(&self) -> ShapeSummary {
+        ShapeSummary::default()
+    }
+}
