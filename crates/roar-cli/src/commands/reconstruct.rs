@@ -87,7 +87,7 @@ pub fn run(args: &ReconstructArgs) -> anyhow::Result<()> {
         .context("an INPUT file is required (or --print-config)")?;
     let output = args.output.as_ref().context("-o OUTPUT is required")?;
     config.validate().map_err(|e| anyhow::anyhow!(e))?;
-    roar_io::MeshFormat::from_path(output)?;
+    roar_io::MeshFormat::for_writing(output)?;
     let started = Instant::now();
     let soup = roar_io::read_mesh(input)?;
 
