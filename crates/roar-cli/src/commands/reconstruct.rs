@@ -45,6 +45,10 @@ pub struct ReconstructArgs {
     /// Also write the JSON report to this file.
     #[arg(long)]
     pub report: Option<PathBuf>,
+    /// Also write a PNG picture: input and output from the same four views (the output with its
+    /// wireframe) and the loss curve of the run.
+    #[arg(long)]
+    pub preview: Option<PathBuf>,
     /// Print the effective configuration as TOML and exit.
     #[arg(long)]
     pub print_config: bool,
@@ -88,6 +92,16 @@ pub fn run(args: &ReconstructArgs) -> anyhow::Result<()> {
     let output = args.output.as_ref().context("-o OUTPUT is required")?;
     config.validate().map_err(|e| anyhow::anyhow!(e))?;
     roar_io::MeshFormat::for_writing(output)?;
+    if let Some(preview) = &args.preview {
+        let png = preview
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("png"));
+        anyhow::ensure!(
+            png,
+            "{}: --preview writes a PNG picture; name it *.png",
+            preview.display()
+        );
+    }
     let started = Instant::now();
     let soup = roar_io::read_mesh(input)?;
 
@@ -125,6 +139,16 @@ pub fn run(args: &ReconstructArgs) -> anyhow::Result<()> {
         &EvalOptions::default(),
     )?;
     roar_io::write_mesh(output, &out_soup)?;
+    if let Some(preview) = &args.preview {
+        let losses: Vec<f64> = result.stats.history.iter().map(|r| r.loss).collect();
+        crate::preview::write_preview(
+            preview,
+            (&soup.positions, &soup.triangles),
+            (&out_soup.positions, &out_soup.triangles),
+            &losses,
+            &crate::preview::PreviewOptions::default(),
+        )?;
+    }
     let report = ReconstructReport {
         input: input.display().to_string(),
         output: output.display().to_string(),
