@@ -10,3 +10,4 @@ pub mod commands;
 pub mod example;
 pub mod input;
 pub mod pipeline;
+pub mod preview;

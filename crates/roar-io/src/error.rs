@@ -60,7 +60,7 @@ pub enum IoError {
     },
     /// The file name's extension names no mesh format we know.
     #[error(
-        "{}: unknown mesh file extension {extension:?} (expected one of: obj, ply, stl, off)",
+        "{}: unknown mesh file extension {extension:?} (expected one of: obj, ply, stl, off, gltf, glb)",
         path.display()
     )]
     UnknownFormat {

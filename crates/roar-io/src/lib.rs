@@ -2,12 +2,13 @@
 //!
 //! [`TriangleSoup`] (plain buffers in which anything goes) and readers and writers for the mesh
 //! formats roar speaks: OBJ, PLY (ASCII, binary little and big endian), STL (ASCII and binary)
-//! and OFF; image dumps (PNG, EXR); atomic writes.
+//! and OFF; glTF 2.0 input (`.gltf`, `.glb`; see [`read_gltf_file`]); image dumps (PNG, EXR);
+//! atomic writes.
 //!
 //! ## Naming
 //!
 //! * `read_mesh(path)` / `write_mesh(path, soup)` pick the format from the extension
-//!   (case-insensitive: `obj`, `ply`, `stl`, `off`).
+//!   (case-insensitive: `obj`, `ply`, `stl`, `off`; `gltf` and `glb` for reading only).
 //! * `read_<fmt>(bytes, name)` parses a file already in memory; `name` only labels errors.
 //! * `write_<fmt>(writer, soup[, encoding])` streams a soup into any writer.
 //!
@@ -29,6 +30,7 @@
 
 mod atomic;
 mod error;
+mod gltf;
 mod image_dump;
 mod obj;
 mod off;
@@ -45,6 +47,7 @@ pub use atomic::{
     write_destination,
 };
 pub use error::{IoError, Location};
+pub use gltf::{read_gltf, read_gltf_file};
 pub use image_dump::{write_exr_rgba, write_png_rgba8};
 pub use obj::{read_obj, write_obj};
 pub use off::{read_off, write_off};
@@ -64,6 +67,8 @@ pub enum MeshFormat {
     Stl,
     /// `.off`.
     Off,
+    /// glTF 2.0, `.gltf` (JSON with its buffers) or `.glb` (binary); read only.
+    Gltf,
 }
 
 impl MeshFormat {
@@ -78,10 +83,24 @@ impl MeshFormat {
             "ply" => Ok(MeshFormat::Ply),
             "stl" => Ok(MeshFormat::Stl),
             "off" => Ok(MeshFormat::Off),
+            "gltf" | "glb" => Ok(MeshFormat::Gltf),
             _ => Err(IoError::UnknownFormat {
                 path: path.to_path_buf(),
                 extension,
             }),
+        }
+    }
+
+    /// The format named by `path`'s extension, refusing formats roar reads but does not write
+    /// (glTF), so a command can check its output path before any work.
+    pub fn for_writing(path: &Path) -> Result<MeshFormat, IoError> {
+        match MeshFormat::from_path(path)? {
+            MeshFormat::Gltf => Err(IoError::InvalidInput {
+                path: path.to_path_buf(),
+                message: "roar reads glTF but does not write it (write obj, ply, stl or off)"
+                    .to_string(),
+            }),
+            format => Ok(format),
         }
     }
 }
@@ -98,9 +117,13 @@ pub struct WriteOptions {
 /// Reads a mesh file, choosing the reader by extension (see [`MeshFormat::from_path`]).
 ///
 /// Errors: unknown extension, the file cannot be read, or its content is malformed (see the
-/// per-format readers); every message names the file.
+/// per-format readers); every message names the file. A `.gltf`'s external buffers are read
+/// from its folder.
 pub fn read_mesh(path: &Path) -> Result<TriangleSoup, IoError> {
     let format = MeshFormat::from_path(path)?;
+    if format == MeshFormat::Gltf {
+        return read_gltf_file(path);
+    }
     let bytes = std::fs::read(path).map_err(|source| IoError::Os {
         path: path.to_path_buf(),
         source,
@@ -108,7 +131,8 @@ pub fn read_mesh(path: &Path) -> Result<TriangleSoup, IoError> {
     read_mesh_bytes(&bytes, &path.display().to_string(), format)
 }
 
-/// Parses a mesh already in memory in the given format; `name` labels errors.
+/// Parses a mesh already in memory in the given format; `name` labels errors. glTF must be
+/// self-contained here (`.glb` or `data:` buffers, see [`read_gltf`]).
 pub fn read_mesh_bytes(
     bytes: &[u8],
     name: &str,
@@ -119,6 +143,7 @@ pub fn read_mesh_bytes(
         MeshFormat::Ply => read_ply(bytes, name),
         MeshFormat::Stl => read_stl(bytes, name),
         MeshFormat::Off => read_off(bytes, name),
+        MeshFormat::Gltf => read_gltf(bytes, name),
     }
 }
 
@@ -149,7 +174,7 @@ pub fn write_mesh_and_files(
     options: &WriteOptions,
     others: &[(&Path, &[u8])],
 ) -> Result<(), IoError> {
-    let format = MeshFormat::from_path(path)?;
+    let format = MeshFormat::for_writing(path)?;
     soup.validate().map_err(|defect| IoError::InvalidInput {
         path: path.to_path_buf(),
         message: format!("cannot write an invalid mesh: {defect}"),
@@ -161,6 +186,10 @@ pub fn write_mesh_and_files(
             MeshFormat::Ply => write_ply(w, soup, options.ply),
             MeshFormat::Stl => write_stl(w, soup, options.stl),
             MeshFormat::Off => write_off(w, soup),
+            MeshFormat::Gltf => Err(std::io::Error::new(
+                std::io::ErrorKind::InvalidInput,
+                "roar does not write glTF",
+            )),
         }),
     )];
     for &(other, bytes) in others {

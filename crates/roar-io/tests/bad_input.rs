@@ -273,7 +273,7 @@ fn content_in_the_wrong_format_is_an_error() {
 
 #[test]
 fn unknown_or_missing_extensions_are_errors() {
-    for name in ["m.xyz", "m", "m.obj.bak", "m.gltf"] {
+    for name in ["m.xyz", "m", "m.obj.bak", "m.fbx"] {
         let (path, result, _dir) = read_as(name, OBJ.as_bytes());
         let message = result.unwrap_err().to_string();
         assert!(

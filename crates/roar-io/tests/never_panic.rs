@@ -6,11 +6,12 @@ mod common;
 use proptest::prelude::*;
 use roar_io::{MeshFormat, read_mesh_bytes};
 
-const FORMATS: [MeshFormat; 4] = [
+const FORMATS: [MeshFormat; 5] = [
     MeshFormat::Obj,
     MeshFormat::Ply,
     MeshFormat::Stl,
     MeshFormat::Off,
+    MeshFormat::Gltf,
 ];
 
 /// Feeds `bytes` to every reader; an accepted soup must pass `validate`.
@@ -125,4 +126,30 @@ proptest! {
         header.extend_from_slice(&bytes[header_len..]);
         read_everywhere(&header);
     }
+
+    #[test]
+    fn mutated_gltf_files_never_panic(
+        binary in any::<bool>(),
+        edits in prop::collection::vec(edit(), 1..6),
+    ) {
+        let mut bytes = if binary { valid_gltf().glb() } else { valid_gltf().gltf_embedded() };
+        for e in &edits {
+            apply(&mut bytes, e);
+        }
+        read_everywhere(&bytes);
+    }
+}
+
+/// A tetrahedron under a mirrored node inside a translated parent: exercises the transforms,
+/// the index accessor and the buffer view bounds.
+fn valid_gltf() -> common::gltf::GltfBuilder {
+    let (points, indices) = common::gltf::tetrahedron();
+    let mut b = common::gltf::GltfBuilder::default();
+    let pos = b.add_positions(&points);
+    let idx = b.add_indices_u16(&indices.iter().map(|&i| i as u16).collect::<Vec<_>>());
+    let mesh = b.add_mesh(pos, Some(idx), None);
+    let child = b.add_node(&format!(r#""mesh":{mesh},"scale":[-1,2,1]"#));
+    let root = b.add_node(&format!(r#""children":[{child}],"translation":[1,2,3]"#));
+    b.add_scene(&[root]);
+    b
 }

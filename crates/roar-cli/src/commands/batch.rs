@@ -229,6 +229,7 @@ fn reconstruct_args(
         print_config: false,
         quiet: true,
         force: false,
+        preview: None,
     }
 }
 

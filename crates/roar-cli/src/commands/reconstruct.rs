@@ -47,6 +47,10 @@ pub struct ReconstructArgs {
     /// Also write the JSON report to this file.
     #[arg(long)]
     pub report: Option<PathBuf>,
+    /// Also write a PNG picture: input and output from the same four views (the output with its
+    /// wireframe) and the loss curve of the run.
+    #[arg(long)]
+    pub preview: Option<PathBuf>,
     /// Print the effective configuration as TOML and exit.
     #[arg(long)]
     pub print_config: bool,
@@ -92,12 +96,23 @@ pub fn run(args: &ReconstructArgs) -> anyhow::Result<()> {
         .context("an INPUT file is required (or --print-config)")?;
     let output = args.output.as_ref().context("-o OUTPUT is required")?;
     config.validate().map_err(|e| anyhow::anyhow!(e))?;
+    if let Some(preview) = &args.preview {
+        let png = preview
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("png"));
+        anyhow::ensure!(
+            png,
+            "{}: --preview writes a PNG picture; name it *.png",
+            preview.display()
+        );
+    }
     let mut inputs = vec![("INPUT", input.as_path())];
     inputs.extend(args.config.as_deref().map(|c| ("--config", c)));
     let mut outputs = vec![("-o", output.as_path())];
     outputs.extend(args.report.as_deref().map(|r| ("--report", r)));
+    outputs.extend(args.preview.as_deref().map(|p| ("--preview", p)));
     check_paths(&inputs, &outputs)?;
-    roar_io::MeshFormat::from_path(output)?;
+    roar_io::MeshFormat::for_writing(output)?;
     let started = Instant::now();
     let soup = roar_io::read_mesh(input)?;
     check_resources(&config, soup.triangles.len(), args.force)?;
@@ -175,6 +190,16 @@ pub fn run(args: &ReconstructArgs) -> anyhow::Result<()> {
         &roar_io::WriteOptions::default(),
         &others,
     )?;
+    if let Some(preview) = &args.preview {
+        let losses: Vec<f64> = report.run.history.iter().map(|r| r.loss).collect();
+        crate::preview::write_preview(
+            preview,
+            (&soup.positions, &soup.triangles),
+            (&out_soup.positions, &out_soup.triangles),
+            &losses,
+            &crate::preview::PreviewOptions::default(),
+        )?;
+    }
     if !args.quiet {
         println!("{json}");
     }

@@ -20,6 +20,8 @@ pub mod config;
 pub mod soup;
 
 use std::collections::BTreeMap;
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
 
 use glam::DVec3;
@@ -73,6 +75,9 @@ pub enum PipelineError {
     /// Self-intersections survived the untangle block.
     #[error("{0} faces still intersect after the untangle block")]
     Intersections(usize),
+    /// [`Reconstruction::cancel`] was set; the run stopped at its next progress report.
+    #[error("cancelled")]
+    Cancelled,
 }
 
 /// What the pipeline hands to a loss factory: what the input [`Shape`] gave, in rig
@@ -223,6 +228,10 @@ pub struct Reconstruction {
     /// The remeshing schedule (default: Face Collapse + flips every iteration, Face Split every
     /// 10, tangential smoothing every 5; spec §1.2).
     pub blocks: Vec<ScheduledBlock>,
+    /// When set (by another thread, a signal handler, a binding), the run stops with
+    /// [`PipelineError::Cancelled`] at its next progress report (once per iteration of the
+    /// loop, and between stages). `None` (the default) never cancels.
+    pub cancel: Option<Arc<AtomicBool>>,
 }
 
 impl Reconstruction {
@@ -233,6 +242,7 @@ impl Reconstruction {
             config,
             loss_factory: Box::new(default_loss),
             blocks,
+            cancel: None,
         }
     }
 
@@ -259,6 +269,7 @@ impl Reconstruction {
         config.validate().map_err(PipelineError::Config)?;
         let mut stats = RunStats::default();
         let mut clock = StageClock::start();
+        let cancel = self.cancel.clone();
         let mut report = |stage, iteration, loss, faces| {
             progress(&Progress {
                 stage,
@@ -266,10 +277,14 @@ impl Reconstruction {
                 iterations: config.iterations,
                 loss,
                 faces,
-            })
+            });
+            match &cancel {
+                Some(flag) if flag.load(Ordering::Relaxed) => Err(PipelineError::Cancelled),
+                _ => Ok(()),
+            }
         };
 
-        report("target", 0, f64::NAN, 0);
+        report("target", 0, f64::NAN, 0)?;
         let cameras = rig_cameras(&config);
         shape.prepare(&cameras)?;
         let normalization = shape.normalization();
@@ -278,11 +293,11 @@ impl Reconstruction {
         stats.twins_dropped = summary.twins_dropped;
         clock.lap("target");
 
-        report("init", 0, f64::NAN, 0);
+        report("init", 0, f64::NAN, 0)?;
         let mut mesh = initial_mesh(&*shape, &config, &mut stats)?;
         clock.lap("init");
 
-        report("point_cloud", 0, f64::NAN, mesh.n_faces());
+        report("point_cloud", 0, f64::NAN, mesh.n_faces())?;
         let cloud = shape.point_cloud(&mesh)?;
         if cloud.points.is_empty() || cloud.points.len() != cloud.normals.len() {
             return Err(PipelineError::Loss(LossError::InvalidTarget(format!(
@@ -380,11 +395,11 @@ impl Reconstruction {
                     clock.lap(&format!("loop_block_{}", scheduled.block.name()));
                 }
             }
-            report("optimize", iteration, value, mesh.n_faces());
+            report("optimize", iteration, value, mesh.n_faces())?;
         }
         stats.loop_faces = mesh.n_faces();
 
-        report("finish", config.iterations, stats.loss_last, mesh.n_faces());
+        report("finish", config.iterations, stats.loss_last, mesh.n_faces())?;
         // The last state's loss decides only when there are other states to compare with.
         let last = if states.is_empty() {
             f64::NAN
@@ -407,7 +422,7 @@ impl Reconstruction {
             config.iterations,
             stats.loss_last,
             mesh.n_faces(),
-        );
+        )?;
         let polishing = config.iterations > 0 && config.polish_iterations > 0;
         for faces in finish_budgets(mesh.n_faces(), config.faces, polishing) {
             if polishing && config.final_qem_offset > 0.0 {
@@ -436,7 +451,7 @@ impl Reconstruction {
 
             // No Move Vertices step at all with `iterations = 0`: that run is the plain init + QEM.
             if polishing {
-                report("polish", config.iterations, stats.loss_last, mesh.n_faces());
+                report("polish", config.iterations, stats.loss_last, mesh.n_faces())?;
                 mesh = polish(
                     mesh,
                     loss.as_mut(),

@@ -1,6 +1,8 @@
 //! Small hand-made soups and valid files in every format, shared by the integration tests.
 #![allow(dead_code)]
 
+pub mod gltf;
+
 use glam::DVec3;
 use roar_io::{PlyEncoding, StlEncoding, TriangleSoup, write_obj, write_off, write_ply, write_stl};
 

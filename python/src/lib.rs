@@ -1,0 +1,312 @@
+//! `roar._roar`: the compiled half of the Python package.
+//!
+//! The Python half (`python/roar/__init__.py`) checks and converts the numpy arrays and hands
+//! them over as little-endian bytes (`<f8` positions, `<u4` triangles); this half decodes them,
+//! runs roar with the GIL released and hands bytes and JSON back. Every error is a one-line
+//! message, as the CLI prints it: `ValueError` for unusable input or config, `roar.RoarError`
+//! for a failure of the work itself, `KeyboardInterrupt` (or the callback's own exception) when
+//! the progress check stopped the run.
+
+use std::path::PathBuf;
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
+
+use glam::DVec3;
+use pyo3::create_exception;
+use pyo3::exceptions::{PyRuntimeError, PyValueError};
+use pyo3::prelude::*;
+use pyo3::types::{PyBytes, PyDict};
+use roar_cli::pipeline::{PipelineError, Progress, ReconstructConfig, Reconstruction, SoupShape};
+use roar_eval::EvalOptions;
+use roar_io::TriangleSoup;
+use roar_mesh::Mesh;
+
+create_exception!(
+    _roar,
+    RoarError,
+    PyRuntimeError,
+    "roar could not do the work asked (the message is the CLI's)."
+);
+
+/// Positions and triangles decoded from the bytes the Python half sends.
+fn soup_from_bytes(positions: &[u8], triangles: &[u8]) -> PyResult<TriangleSoup> {
+    if !positions.len().is_multiple_of(24) || !triangles.len().is_multiple_of(12) {
+        return Err(PyValueError::new_err(
+            "internal: position or triangle bytes are not whole rows",
+        ));
+    }
+    let f = |c: &[u8]| f64::from_le_bytes(c.try_into().expect("8-byte chunk"));
+    let u = |c: &[u8]| u32::from_le_bytes(c.try_into().expect("4-byte chunk"));
+    let positions = positions
+        .chunks_exact(24)
+        .map(|r| DVec3::new(f(&r[..8]), f(&r[8..16]), f(&r[16..])))
+        .collect();
+    let triangles = triangles
+        .chunks_exact(12)
+        .map(|r| [u(&r[..4]), u(&r[4..8]), u(&r[8..])])
+        .collect();
+    let soup = TriangleSoup::new(positions, triangles);
+    soup.validate()
+        .map_err(|defect| PyValueError::new_err(defect.to_string()))?;
+    Ok(soup)
+}
+
+/// Positions and triangles as the bytes the Python half turns back into arrays.
+fn soup_to_bytes<'py>(
+    py: Python<'py>,
+    positions: &[DVec3],
+    triangles: &[[u32; 3]],
+) -> (Bound<'py, PyBytes>, Bound<'py, PyBytes>) {
+    let p: Vec<u8> = positions
+        .iter()
+        .flat_map(|v| v.to_array())
+        .flat_map(f64::to_le_bytes)
+        .collect();
+    let t: Vec<u8> = triangles
+        .iter()
+        .flatten()
+        .flat_map(|i| i.to_le_bytes())
+        .collect();
+    (PyBytes::new(py, &p), PyBytes::new(py, &t))
+}
+
+fn roar_error(e: impl std::fmt::Display) -> PyErr {
+    RoarError::new_err(e.to_string())
+}
+
+/// The effective config: defaults, then the JSON of the user's dict (the CLI's TOML layout),
+/// then the face budget; validated like the CLI's.
+fn effective_config(config_json: &str, faces: usize) -> PyResult<ReconstructConfig> {
+    let mut config: ReconstructConfig = serde_json::from_str(config_json)
+        .map_err(|e| PyValueError::new_err(format!("config: {e}")))?;
+    config.faces = faces;
+    config
+        .validate()
+        .map_err(|e| PyValueError::new_err(format!("config: {e}")))?;
+    Ok(config)
+}
+
+/// Runs the reconstruction (GIL released) and returns `(positions, triangles, report_json)`.
+/// `label` names the input in the report and in error messages (a path, or `<arrays>`).
+#[pyfunction]
+#[pyo3(signature = (positions, triangles, faces, config_json, label, progress=None))]
+fn reconstruct<'py>(
+    py: Python<'py>,
+    positions: &[u8],
+    triangles: &[u8],
+    faces: usize,
+    config_json: &str,
+    label: &str,
+    progress: Option<Py<PyAny>>,
+) -> PyResult<(Bound<'py, PyBytes>, Bound<'py, PyBytes>, String)> {
+    let soup = soup_from_bytes(positions, triangles)?;
+    let config = effective_config(config_json, faces)?;
+    run_reconstruction(py, &soup, config, label, progress)
+}
+
+/// Reads a mesh file of any format the CLI reads (OBJ, PLY, STL, OFF, glTF) and returns
+/// `(positions, triangles)`.
+#[pyfunction]
+fn read_mesh<'py>(
+    py: Python<'py>,
+    path: PathBuf,
+) -> PyResult<(Bound<'py, PyBytes>, Bound<'py, PyBytes>)> {
+    let soup = py
+        .detach(|| roar_io::read_mesh(&path))
+        .map_err(roar_error)?;
+    Ok(soup_to_bytes(py, &soup.positions, &soup.triangles))
+}
+
+/// Writes a mesh atomically, format by extension (as the CLI writes its output).
+#[pyfunction]
+fn write_mesh(py: Python<'_>, path: PathBuf, positions: &[u8], triangles: &[u8]) -> PyResult<()> {
+    let soup = soup_from_bytes(positions, triangles)?;
+    py.detach(|| roar_io::write_mesh(&path, &soup))
+        .map_err(roar_error)
+}
+
+fn run_reconstruction<'py>(
+    py: Python<'py>,
+    soup: &TriangleSoup,
+    config: ReconstructConfig,
+    label: &str,
+    progress: Option<Py<PyAny>>,
+) -> PyResult<(Bound<'py, PyBytes>, Bound<'py, PyBytes>, String)> {
+    let cancel = Arc::new(AtomicBool::new(false));
+    let mut stopped_by: Option<PyErr> = None;
+    let started = std::time::Instant::now();
+    let outcome = py.detach(|| {
+        let mut reconstruction = Reconstruction::new(config.clone());
+        reconstruction.cancel = Some(cancel.clone());
+        let mut on_progress = |p: &Progress| {
+            if stopped_by.is_some() {
+                return;
+            }
+            // Once per report: the user's callback, then pending signals (Ctrl-C).
+            let checked = Python::attach(|py| -> PyResult<()> {
+                if let Some(callback) = &progress {
+                    let record = PyDict::new(py);
+                    record.set_item("stage", p.stage)?;
+                    record.set_item("iteration", p.iteration)?;
+                    record.set_item("iterations", p.iterations)?;
+                    record.set_item("loss", p.loss)?;
+                    record.set_item("faces", p.faces)?;
+                    callback.call1(py, (record,))?;
+                }
+                py.check_signals()
+            });
+            if let Err(e) = checked {
+                stopped_by = Some(e);
+                cancel.store(true, Ordering::Relaxed);
+            }
+        };
+        let mut shape = SoupShape::new(label, &soup.positions, &soup.triangles, &config);
+        let result = reconstruction.run(&mut shape, &mut on_progress)?;
+        drop(shape);
+        let eval_input = EvalOptions {
+            self_intersections: None,
+            ..EvalOptions::default()
+        };
+        let input_metrics =
+            roar_eval::evaluate(&soup.positions, &soup.triangles, None, &eval_input)
+                .map_err(|e| PipelineError::Internal(e.to_string()))?;
+        let output_metrics = roar_eval::evaluate(
+            &result.positions,
+            &result.triangles,
+            Some((&soup.positions, &soup.triangles)),
+            &EvalOptions::default(),
+        )
+        .map_err(|e| PipelineError::Internal(e.to_string()))?;
+        Ok::<_, PipelineError>((result, input_metrics, output_metrics))
+    });
+    if let Some(e) = stopped_by {
+        return Err(e);
+    }
+    let (result, input_metrics, output_metrics) =
+        outcome.map_err(|e| roar_error(format!("{label}: reconstruction failed: {e}")))?;
+    let report = serde_json::json!({
+        "input": label,
+        "seed": config.seed,
+        "seconds_total": started.elapsed().as_secs_f64(),
+        "input_metrics": input_metrics,
+        "output_metrics": output_metrics,
+        "run": result.stats,
+        "config": config,
+    });
+    let (p, t) = soup_to_bytes(py, &result.positions, &result.triangles);
+    Ok((p, t, report.to_string()))
+}
+
+/// The metrics report (JSON) of a soup, with fidelity against `reference` when given.
+#[pyfunction]
+#[pyo3(signature = (positions, triangles, reference=None))]
+fn eval(
+    py: Python<'_>,
+    positions: &[u8],
+    triangles: &[u8],
+    reference: Option<(Bound<'_, PyBytes>, Bound<'_, PyBytes>)>,
+) -> PyResult<String> {
+    let soup = soup_from_bytes(positions, triangles)?;
+    let reference = reference
+        .map(|(p, t)| soup_from_bytes(p.as_bytes(), t.as_bytes()))
+        .transpose()?;
+    let report = py
+        .detach(|| {
+            roar_eval::evaluate(
+                &soup.positions,
+                &soup.triangles,
+                reference
+                    .as_ref()
+                    .map(|r| (r.positions.as_slice(), r.triangles.as_slice())),
+                &EvalOptions::default(),
+            )
+        })
+        .map_err(roar_error)?;
+    serde_json::to_string(&report).map_err(roar_error)
+}
+
+/// The soup welded at bit-identical positions as a closed 2-manifold, or the CLI's message.
+fn closed_mesh(soup: &TriangleSoup) -> PyResult<Mesh> {
+    let (positions, triangles) = roar_cli::input::welded_referenced(soup);
+    Mesh::from_triangles(positions, &triangles).map_err(|e| {
+        PyValueError::new_err(format!(
+            "the mesh is not a closed, oriented 2-manifold (run roar.init on it first): {e}"
+        ))
+    })
+}
+
+/// The guaranteed QEM of a closed 2-manifold to exactly `faces` faces; returns
+/// `(positions, triangles, reached_target)`.
+#[pyfunction]
+fn decimate<'py>(
+    py: Python<'py>,
+    positions: &[u8],
+    triangles: &[u8],
+    faces: usize,
+    best_effort: bool,
+) -> PyResult<(Bound<'py, PyBytes>, Bound<'py, PyBytes>, bool)> {
+    let soup = soup_from_bytes(positions, triangles)?;
+    let mut mesh = closed_mesh(&soup)?;
+    let options = roar_ops::decimate::DecimateOptions {
+        best_effort,
+        ..roar_ops::decimate::DecimateOptions::default()
+    };
+    let stats = py
+        .detach(|| roar_ops::decimate::decimate_in_parallel(&mut mesh, faces, &options))
+        .map_err(roar_error)?;
+    let (p, t) = mesh.to_triangles();
+    let (p, t) = soup_to_bytes(py, &p, &t);
+    Ok((p, t, stats.reached_target))
+}
+
+/// The watertight init of any soup, decimated to at most `faces` faces (`resolution` 0: the
+/// CLI's default); returns `(positions, triangles)`.
+#[pyfunction]
+fn init<'py>(
+    py: Python<'py>,
+    positions: &[u8],
+    triangles: &[u8],
+    resolution: usize,
+    faces: usize,
+) -> PyResult<(Bound<'py, PyBytes>, Bound<'py, PyBytes>)> {
+    let soup = soup_from_bytes(positions, triangles)?;
+    roar_cli::input::check_even_budget(faces).map_err(|e| PyValueError::new_err(e.to_string()))?;
+    let (positions, triangles) = roar_cli::input::welded_referenced(&soup);
+    let options = roar_ops::init::InitialMeshOptions {
+        init: roar_ops::init::InitOptions {
+            resolution: if resolution == 0 {
+                roar_ops::init::InitOptions::default().resolution
+            } else {
+                resolution
+            },
+            ..roar_ops::init::InitOptions::default()
+        },
+        max_faces: faces,
+        ..roar_ops::init::InitialMeshOptions::default()
+    };
+    let (mesh, _) = py
+        .detach(|| roar_ops::init::initial_mesh(&positions, &triangles, &options))
+        .map_err(|e| roar_error(format!("watertight init failed: {e}")))?;
+    let (p, t) = mesh.to_triangles();
+    Ok(soup_to_bytes(py, &p, &t))
+}
+
+/// The default configuration as JSON (the CLI's `--print-config`, in JSON).
+#[pyfunction]
+fn default_config() -> PyResult<String> {
+    serde_json::to_string(&ReconstructConfig::default()).map_err(roar_error)
+}
+
+/// The compiled module.
+#[pymodule]
+fn _roar(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add("RoarError", m.py().get_type::<RoarError>())?;
+    m.add_function(wrap_pyfunction!(reconstruct, m)?)?;
+    m.add_function(wrap_pyfunction!(read_mesh, m)?)?;
+    m.add_function(wrap_pyfunction!(write_mesh, m)?)?;
+    m.add_function(wrap_pyfunction!(eval, m)?)?;
+    m.add_function(wrap_pyfunction!(decimate, m)?)?;
+    m.add_function(wrap_pyfunction!(init, m)?)?;
+    m.add_function(wrap_pyfunction!(default_config, m)?)?;
+    Ok(())
+}

@@ -1,0 +1,240 @@
+"""The Python package against the installed wheel: arrays in and out, errors, progress,
+Ctrl-C, the GIL released while roar works, glTF files written by trimesh, and a Dask map."""
+
+import functools
+import os
+import pathlib
+import threading
+import _thread
+
+import numpy as np
+import pytest
+import trimesh
+
+import roar
+
+REPO = pathlib.Path(__file__).resolve().parents[2]
+EXAMPLE = REPO / "examples" / "chair_soup.obj"
+
+# Toy settings (as the Rust pipeline tests use): seconds, not minutes.
+TOY = {
+    "iterations": 6,
+    "init_resolution": 32,
+    "init_max_faces": 4000,
+    "working_budget_min": 600,
+    "views_per_axis": 2,
+    "render_resolution": 64,
+    "point_cloud_samples": 5000,
+    "sharp_edge_samples": 1000,
+    "planar_max_samples": 5000,
+    "split_interval": 3,
+    "smoothing_interval": 2,
+}
+
+
+def example():
+    mesh = trimesh.load(EXAMPLE, process=False, force="mesh")
+    return np.asarray(mesh.vertices), np.asarray(mesh.faces)
+
+
+def signed_volume(vertices, faces):
+    a, b, c = (vertices[faces[:, i]] for i in range(3))
+    return float(np.einsum("ij,ij->i", a, np.cross(b, c)).sum() / 6.0)
+
+
+def test_round_trip_with_trimesh():
+    v, f = example()
+    out_v, out_f, report = roar.reconstruct(v, f, target_faces=200, config=TOY)
+    assert out_v.dtype == np.float64 and out_v.shape[1] == 3
+    assert out_f.dtype == np.int64 and out_f.shape == (200, 3)
+    mesh = trimesh.Trimesh(out_v, out_f, process=False)
+    assert mesh.is_watertight and mesh.is_winding_consistent
+    assert mesh.volume > 0
+    assert report["output_metrics"]["topology"]["faces"] == 200
+    assert report["input"] == "<arrays>"
+    assert report["config"]["iterations"] == TOY["iterations"]
+    # Same seed, same input: the same mesh, from any accepted dtype.
+    again = roar.reconstruct(v.astype(np.float64), f.astype(np.uint32), 200, config=TOY)
+    assert np.array_equal(again[0], out_v) and np.array_equal(again[1], out_f)
+
+
+def test_every_accepted_dtype_reads_the_same_soup():
+    v, f = example()
+    v32 = v.astype(np.float32)
+    reports = [
+        roar.eval(v32, f.astype(dtype)) for dtype in (np.int32, np.int64, np.uint32)
+    ]
+    assert reports[0] == reports[1] == reports[2]
+    assert reports[0]["topology"]["faces"] == len(f)
+
+
+@pytest.mark.parametrize(
+    "vertices, faces, message",
+    [
+        (np.zeros((4, 2)), np.array([[0, 1, 2]]), "shape (n, 3)"),
+        (np.zeros((4, 3), dtype=np.int64), np.array([[0, 1, 2]]), "float32 or float64"),
+        (np.zeros((4, 3)), np.array([[0, 1, 2]], dtype=np.float64), "int32, int64 or uint32"),
+        (np.zeros((4, 3)), np.array([0, 1, 2]), "shape (m, 3)"),
+        (np.array([[0, 0, 0], [1, 0, 0], [np.nan, 1, 0]]), np.array([[0, 1, 2]]), "vertex 2"),
+        (np.zeros((3, 3)), np.array([[0, 1, 3]]), "index 3 out of range"),
+        (np.zeros((3, 3)), np.array([[0, -1, 2]]), "index -1 out of range"),
+        (np.zeros((3, 3)), np.zeros((0, 3), dtype=np.int64), "no triangles"),
+    ],
+)
+def test_bad_arrays_raise_value_error_before_any_work(vertices, faces, message):
+    calls = []
+    with pytest.raises(ValueError, match=message.replace("(", r"\(").replace(")", r"\)")):
+        roar.reconstruct(vertices, faces, 200, config=TOY, progress=calls.append)
+    assert calls == []
+
+
+def test_bad_config_and_budget_raise_value_error():
+    v, f = example()
+    with pytest.raises(ValueError, match="unknown field"):
+        roar.reconstruct(v, f, 200, config={"no_such_key": 1})
+    with pytest.raises(ValueError, match="config"):
+        roar.reconstruct(v, f, 201, config=TOY)
+    with pytest.raises(ValueError, match="target_faces"):
+        roar.reconstruct(v, f, 0)
+
+
+def test_errors_carry_the_cli_message(tmp_path):
+    missing = tmp_path / "missing.obj"
+    with pytest.raises(roar.RoarError, match=str(missing)):
+        roar.reconstruct_file(missing, 200, config=TOY)
+    bad = tmp_path / "bad.obj"
+    bad.write_text("v 0 0 0\nf 1 2 3\n")
+    with pytest.raises(roar.RoarError) as info:
+        roar.reconstruct_file(bad, 200, config=TOY)
+    assert str(info.value).startswith(f"{bad}:2:")
+    assert "\n" not in str(info.value)
+
+
+def test_progress_gets_the_cli_records_and_its_exception_stops_the_run():
+    v, f = example()
+    records = []
+    roar.reconstruct(v, f, 200, config=TOY, progress=records.append)
+    stages = [r["stage"] for r in records]
+    for stage in ("target", "init", "optimize", "decimate"):
+        assert stage in stages
+    optimize = [r for r in records if r["stage"] == "optimize"]
+    assert [r["iteration"] for r in optimize] == list(range(TOY["iterations"]))
+    assert all(set(r) == {"stage", "iteration", "iterations", "loss", "faces"} for r in records)
+
+    class Stop(Exception):
+        pass
+
+    def stop_at_optimize(record):
+        if record["stage"] == "optimize":
+            raise Stop("enough")
+
+    with pytest.raises(Stop):
+        roar.reconstruct(v, f, 200, config=TOY, progress=stop_at_optimize)
+
+
+def test_ctrl_c_raises_keyboard_interrupt_and_stops_the_run():
+    v, f = example()
+    long_run = dict(TOY, iterations=500)
+    optimize = []
+
+    def on_progress(record):
+        if record["stage"] == "optimize":
+            optimize.append(record["iteration"])
+            if len(optimize) == 1:
+                # As a terminal's Ctrl-C: SIGINT arrives from outside the running call.
+                threading.Thread(target=_thread.interrupt_main).start()
+
+    with pytest.raises(KeyboardInterrupt):
+        roar.reconstruct(v, f, 200, config=long_run, progress=on_progress)
+    assert len(optimize) < long_run["iterations"]
+
+
+def test_another_thread_runs_while_roar_works():
+    v, f = example()
+    counter = [0]
+    stop = threading.Event()
+
+    def count():
+        while not stop.is_set():
+            counter[0] += 1
+
+    seen = []
+    thread = threading.Thread(target=count)
+    thread.start()
+    try:
+        roar.reconstruct(v, f, 200, config=TOY, progress=lambda r: seen.append(counter[0]))
+    finally:
+        stop.set()
+        thread.join()
+    # The counter advanced between the first and the last progress report, i.e. while roar's
+    # stages ran (with the GIL held throughout, the counting thread would barely run).
+    assert seen[-1] > seen[0]
+
+
+def test_decimate_and_init():
+    sphere = trimesh.creation.icosphere(subdivisions=3)
+    v, f = roar.decimate(sphere.vertices, sphere.faces, 100)
+    assert f.shape == (100, 3)
+    assert trimesh.Trimesh(v, f, process=False).is_watertight
+    with pytest.raises(ValueError, match="closed, oriented 2-manifold"):
+        roar.decimate(sphere.vertices, sphere.faces[:-1], 100)
+    ex_v, ex_f = example()
+    v, f = roar.init(ex_v, ex_f, resolution=32, max_faces=2000)
+    init = trimesh.Trimesh(v, f, process=False)
+    assert init.is_watertight and init.volume > 0 and len(f) <= 2000
+    assert roar.default_config()["faces"] > 0
+
+
+def gltf_scene():
+    """A box and an icosphere under nested nodes, the sphere mirrored by a negative scale."""
+    scene = trimesh.Scene()
+    box = trimesh.creation.box(extents=(1.0, 2.0, 0.5))
+    sphere = trimesh.creation.icosphere(subdivisions=2, radius=0.5)
+    scene.add_geometry(box, node_name="box", transform=trimesh.transformations.translation_matrix([2, 0, 0]))
+    parent = trimesh.transformations.rotation_matrix(0.3, [0, 0, 1])
+    scene.graph.update(frame_to="parent", frame_from=scene.graph.base_frame, matrix=parent)
+    mirror = np.diag([-1.0, 1.0, 1.0, 1.0])
+    mirror[:3, 3] = [0.0, 1.5, 0.0]
+    scene.add_geometry(sphere, node_name="sphere", parent_node_name="parent", transform=mirror)
+    return scene, box.volume + sphere.volume
+
+
+@pytest.mark.parametrize("suffix", [".glb", ".gltf"])
+def test_gltf_written_by_trimesh(tmp_path, suffix):
+    scene, volume = gltf_scene()
+    path = tmp_path / f"scene{suffix}"
+    if suffix == ".glb":
+        path.write_bytes(scene.export(file_type="glb"))
+    else:
+        files = scene.export(file_type="gltf")
+        for name, data in files.items():
+            (tmp_path / ("scene.gltf" if name == "model.gltf" else name)).write_bytes(data)
+    v, f = roar.read_mesh(path)
+    # trimesh's own reading of its file, flattened into one soup.
+    expected = trimesh.load(path, force="scene").to_geometry()
+    assert len(f) == len(expected.faces)
+    got = np.sort(v[f].reshape(-1, 3).round(5), axis=0)
+    want = np.sort(np.asarray(expected.vertices)[expected.faces].reshape(-1, 3).round(5), axis=0)
+    assert np.allclose(got, want, atol=1e-5)
+    # Both closed parts face outward after the mirror: their volumes add up.
+    assert signed_volume(v, f) == pytest.approx(volume, rel=1e-5)
+    out_v, out_f, report = roar.reconstruct_file(path, 200, config=TOY)
+    assert out_f.shape == (200, 3) and report["input"] == str(path)
+
+
+def test_dask_map_over_files_on_a_local_cluster(tmp_path):
+    from dask.distributed import Client, LocalCluster
+
+    paths = [str(EXAMPLE)]
+    sphere = tmp_path / "sphere.ply"
+    trimesh.creation.icosphere(subdivisions=3).export(sphere)
+    paths.append(str(sphere))
+    task = functools.partial(roar.reconstruct_file, target_faces=200, config=TOY)
+    with LocalCluster(
+        n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None
+    ) as cluster, Client(cluster) as client:
+        results = client.gather(client.map(task, paths))
+    assert [r[2]["input"] for r in results] == paths
+    for v, f, _ in results:
+        assert f.shape == (200, 3)
+        assert trimesh.Trimesh(v, f, process=False).is_watertight
