@@ -8,7 +8,8 @@ use serde::{Deserialize, Serialize};
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum InitKind {
-    /// Watertight voxel init of the cleaned target, in the manner of Manifold (§4.1).
+    /// The input shape's own initial mesh (`Shape::initial_mesh`): for a soup the watertight
+    /// voxel init of the cleaned target, in the manner of Manifold (§4.1).
     Watertight,
     /// An icosphere of radius 0.5 (§4.2); its genus is 0, so holes of the input are lost.
     Sphere,
