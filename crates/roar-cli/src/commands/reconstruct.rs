@@ -91,7 +91,9 @@ pub fn run(args: &ReconstructArgs) -> anyhow::Result<()> {
         .as_ref()
         .context("an INPUT file is required (or --print-config)")?;
     let output = args.output.as_ref().context("-o OUTPUT is required")?;
-    config.validate().map_err(|e| anyhow::anyhow!(e))?;
+    config
+        .validate()
+        .map_err(|e| anyhow::anyhow!("config: {e}"))?;
     let mut inputs = vec![("INPUT", input.as_path())];
     inputs.extend(args.config.as_deref().map(|c| ("--config", c)));
     let mut outputs = vec![("-o", output.as_path())];
