@@ -93,7 +93,7 @@ fn range_errors_name_field_value_and_range() {
     let config = with("render_weight", toml::Value::Float(f64::NAN)).unwrap();
     assert_eq!(
         config.validate().unwrap_err(),
-        "config: render_weight = NaN is out of range: allowed 0 to 1000000"
+        "render_weight = NaN is out of range: allowed 0 to 1000000"
     );
     let config = with("sliver_quality", toml::Value::Float(0.5)).unwrap();
     assert!(config.validate().unwrap_err().contains("0 (off) or 1 to"));

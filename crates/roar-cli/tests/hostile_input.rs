@@ -359,3 +359,46 @@ fn a_run_writes_its_mesh_and_report_together_and_nothing_else() {
     assert_eq!(json["output"], s(&out));
     assert_eq!(roar_io::read_mesh(&out).unwrap().triangles.len(), 500);
 }
+
+#[test]
+fn a_budget_below_what_the_inits_pieces_need_is_refused_before_the_loop() {
+    // Two cubes far apart: two pieces of genus 0, so at least 8 faces.
+    let dir = tempfile::tempdir().unwrap();
+    let mut text = String::new();
+    for (k, dx) in [0.0, 5.0].iter().enumerate() {
+        for c in 0..8 {
+            let (x, y, z) = ((c & 1) as f64, ((c >> 1) & 1) as f64, ((c >> 2) & 1) as f64);
+            text += &format!("v {} {y} {z}\n", x + dx);
+        }
+        let o = 8 * k + 1;
+        for [a, b, c, d] in [
+            [0, 2, 3, 1],
+            [4, 5, 7, 6],
+            [0, 1, 5, 4],
+            [2, 6, 7, 3],
+            [0, 4, 6, 2],
+            [1, 3, 7, 5],
+        ] {
+            text += &format!("f {} {} {} {}\n", a + o, b + o, c + o, d + o);
+        }
+    }
+    let cubes = dir.path().join("cubes.obj");
+    std::fs::write(&cubes, text).unwrap();
+    let out = dir.path().join("out.obj");
+    let run = roar(&[
+        "reconstruct",
+        s(&cubes),
+        "-o",
+        s(&out),
+        "--faces",
+        "6",
+        "--iterations",
+        "0",
+        "-q",
+    ]);
+    assert_refused(
+        &run,
+        "smallest reachable budget, 8 faces; use 8 (for the pieces of the init)",
+    );
+    assert!(!out.exists());
+}

@@ -52,7 +52,7 @@ pub use image_dump::{write_exr_rgba, write_png_rgba8};
 pub use obj::{read_obj, write_obj};
 pub use off::{read_off, write_off};
 pub use ply::{PlyEncoding, read_ply, write_ply};
-pub use polygon::{MAX_EAR_CLIPPING_CORNERS, triangulate_polygon};
+pub use polygon::{MAX_EAR_CLIPPING_CORNERS, PLANARITY_TOLERANCE, triangulate_polygon};
 pub use soup::{SoupDefect, TriangleSoup};
 pub use stl::{StlEncoding, read_stl, write_stl};
 

@@ -15,8 +15,9 @@ pub const MAX_EAR_CLIPPING_CORNERS: usize = 4096;
 /// Appends the triangles of the polygon `corners` (indices into `positions`, at least 3) to
 /// `out`, `corners.len() − 2` of them, each wound like the polygon. Returns `false` when the
 /// polygon could not be triangulated cleanly: a corner index out of range, no plane (all
-/// corners on a line or a point), more than [`MAX_EAR_CLIPPING_CORNERS`] corners, or a
-/// self-intersecting outline where no ear is left; the remainder is then fan-triangulated.
+/// corners on a line or a point, or corners off the plane: [`PLANARITY_TOLERANCE`]), more than
+/// [`MAX_EAR_CLIPPING_CORNERS`] corners, or a self-intersecting outline where no ear is left;
+/// the polygon (or what remains of it) is then fan-triangulated.
 pub fn triangulate_polygon(positions: &[DVec3], corners: &[u32], out: &mut Vec<[u32; 3]>) -> bool {
     let n = corners.len();
     if n == 3 {
@@ -33,6 +34,10 @@ pub fn triangulate_polygon(positions: &[DVec3], corners: &[u32], out: &mut Vec<[
     };
     let normal = newell_normal(&points);
     if n > MAX_EAR_CLIPPING_CORNERS || !normal.is_finite() || normal.length() == 0.0 {
+        push_fan(corners, out);
+        return false;
+    }
+    if !is_planar(&points, normal) {
         push_fan(corners, out);
         return false;
     }
@@ -67,6 +72,24 @@ pub fn triangulate_polygon(positions: &[DVec3], corners: &[u32], out: &mut Vec<[
         corners[remaining[2]],
     ]);
     true
+}
+
+/// Relative distance from the polygon's plane above which a polygon counts as non-planar: it has
+/// no plane to be triangulated in, so it keeps the fan (what every tool does with it).
+pub const PLANARITY_TOLERANCE: f64 = 1e-6;
+
+/// Whether every corner lies within [`PLANARITY_TOLERANCE`] × the polygon's extent of the plane
+/// through the centroid with the Newell normal.
+fn is_planar(points: &[DVec3], normal: DVec3) -> bool {
+    let unit = normal.normalize();
+    let centroid = points.iter().copied().sum::<DVec3>() / points.len() as f64;
+    let extent = points
+        .iter()
+        .map(|p| (*p - centroid).length())
+        .fold(0.0, f64::max);
+    points
+        .iter()
+        .all(|p| (*p - centroid).dot(unit).abs() <= PLANARITY_TOLERANCE * extent)
 }
 
 /// The fan `(c0, c1, c2), (c0, c2, c3), …`.
@@ -216,6 +239,17 @@ mod tests {
         out.clear();
         assert!(!triangulate_polygon(&line, &[0, 1, 2, 9], &mut out));
         assert_eq!(out.len(), 2);
+        // A quad bent out of its plane keeps its fan.
+        let bent = [
+            (0.0, 0.0, 0.0),
+            (1.0, 0.0, 0.0),
+            (1.0, 1.0, 0.2),
+            (0.0, 1.0, 0.0),
+        ]
+        .map(|(x, y, z)| DVec3::new(x, y, z));
+        out.clear();
+        assert!(!triangulate_polygon(&bent, &[0, 1, 2, 3], &mut out));
+        assert_eq!(out, [[0, 1, 2], [0, 2, 3]]);
         // A bow tie: its outline crosses itself.
         let bow = [(0.0, 0.0), (2.0, 2.0), (2.0, 0.0), (0.0, 2.0), (-1.0, 1.0)]
             .map(|(x, y)| DVec3::new(x, y, 0.0));

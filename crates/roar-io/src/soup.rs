@@ -21,8 +21,8 @@ pub struct TriangleSoup {
     /// How many faces of the input were polygons with more than 3 corners (0 for soups that were
     /// not read from a file).
     pub n_polygons: usize,
-    /// How many of those polygons could not be triangulated cleanly (no plane, a
-    /// self-intersecting outline, a corner out of range, too many corners) and were
+    /// How many of those polygons could not be triangulated cleanly (no plane, corners off their
+    /// plane, a self-intersecting outline, a corner out of range, too many corners) and were
     /// fan-triangulated, at least in part.
     pub n_polygons_unclean: usize,
 }

@@ -95,7 +95,9 @@ pub fn run(args: &ReconstructArgs) -> anyhow::Result<()> {
         .as_ref()
         .context("an INPUT file is required (or --print-config)")?;
     let output = args.output.as_ref().context("-o OUTPUT is required")?;
-    config.validate().map_err(|e| anyhow::anyhow!(e))?;
+    config
+        .validate()
+        .map_err(|e| anyhow::anyhow!("config: {e}"))?;
     if let Some(preview) = &args.preview {
         let png = preview
             .extension()

@@ -245,7 +245,7 @@ impl ReconstructConfig {
         for (range, value) in self.field_ranges() {
             if !range.allows(value) {
                 return Err(format!(
-                    "config: {} = {} is out of range: allowed {}",
+                    "{} = {} is out of range: allowed {}",
                     range.name,
                     value,
                     range.describe()
@@ -254,7 +254,7 @@ impl ReconstructConfig {
         }
         if self.working_budget_min > self.working_budget_max {
             return Err(format!(
-                "config: working_budget_min = {} is above working_budget_max = {}",
+                "working_budget_min = {} is above working_budget_max = {}",
                 self.working_budget_min, self.working_budget_max
             ));
         }

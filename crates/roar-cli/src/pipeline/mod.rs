@@ -295,6 +295,12 @@ impl Reconstruction {
 
         report("init", 0, f64::NAN, 0)?;
         let mut mesh = initial_mesh(&*shape, &config, &mut stats)?;
+        crate::budget::check_budget(
+            "faces =",
+            config.faces,
+            crate::budget::min_reachable_budget(&mesh.component_genera()),
+        )
+        .map_err(|e| PipelineError::Config(format!("{e} (for the pieces of the init)")))?;
         clock.lap("init");
 
         report("point_cloud", 0, f64::NAN, mesh.n_faces())?;
