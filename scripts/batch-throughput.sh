@@ -35,6 +35,7 @@ t0=$(now); loop 0 & loop 1 & wait; t1=$(now)
 "$roar" batch manifest.csv -o shards --faces 500 --config small.toml --shard 0/2 -q &
 "$roar" batch manifest.csv -o shards --faces 500 --config small.toml --shard 1/2 -q &
 wait; t3=$(now)
-awk -v a="$(echo "$t1 - $t0" | bc)" -v b="$(echo "$t2 - $t1" | bc)" -v c="$(echo "$t3 - $t2" | bc)" -v n="$n" 'BEGIN {
+awk -v t0="$t0" -v t1="$t1" -v t2="$t2" -v t3="$t3" -v n="$n" 'BEGIN {
+  a = t1 - t0; b = t2 - t1; c = t3 - t2
   printf "%d items: two reconstruct loops %.1f s, batch --jobs 2 %.1f s (%.3f), two shards %.1f s (%.3f)\n", n, a, b, b / a, c, c / a
 }'

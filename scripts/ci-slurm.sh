@@ -111,7 +111,7 @@ for _ in $(seq 300); do
   sleep 0.1
 done
 [ "$state" = idle ] || fail "node state is '$state' after 30 s"
-echo "cluster ready in $(echo "$(date +%s.%N) - $started" | bc) s"
+awk -v a="$started" -v b="$(date +%s.%N)" 'BEGIN { printf "cluster ready in %.1f s\n", b - a }'
 
 echo "== a small dataset: generated soups, two budgets"
 data="$work/data"
