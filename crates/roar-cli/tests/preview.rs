@@ -1,26 +1,10 @@
 //! The preview picture: input row, output row with its wireframe, loss curve panel; and the
 //! `--preview` flag writes it as PNG beside the output.
 
-use roar_cli::pipeline::{ReconstructConfig, Reconstruction, SoupShape};
-use roar_cli::preview::{PreviewOptions, WIRE_RGB, preview_image};
+mod common;
 
-fn toy_config() -> ReconstructConfig {
-    ReconstructConfig {
-        faces: 200,
-        iterations: 6,
-        init_resolution: 32,
-        init_max_faces: 4000,
-        working_budget_min: 600,
-        views_per_axis: 2,
-        render_resolution: 64,
-        point_cloud_samples: 5000,
-        sharp_edge_samples: 1000,
-        planar_max_samples: 5000,
-        split_interval: 3,
-        smoothing_interval: 2,
-        ..ReconstructConfig::default()
-    }
-}
+use roar_cli::pipeline::Reconstruction;
+use roar_cli::preview::{PreviewOptions, WIRE_RGB, preview_image};
 
 /// Pixels of the picture's region `(x0, y0, w, h)` that are not the white background, and those
 /// of the wire colour.
@@ -44,10 +28,8 @@ fn count(image: &roar_cli::preview::PreviewImage, region: (u32, u32, u32, u32)) 
 #[test]
 fn the_preview_shows_input_output_wireframe_and_curve() {
     let soup = roar_cli::example::chair_soup();
-    let config = toy_config();
-    let mut shape = SoupShape::new("chair_soup", &soup.positions, &soup.triangles, &config);
-    let out = Reconstruction::new(config)
-        .run(&mut shape, &mut |_| {})
+    let out = Reconstruction::new(common::toy_config(200, 6))
+        .run_soup(&soup.positions, &soup.triangles, &mut |_| {})
         .unwrap();
     let losses: Vec<f64> = out.stats.history.iter().map(|r| r.loss).collect();
     let options = PreviewOptions { tile: 96 };

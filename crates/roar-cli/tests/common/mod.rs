@@ -1,0 +1,27 @@
+//! Shared by the pipeline's integration tests: toy settings fast enough for the default test
+//! run, and (through `gltf`) roar-io's small glTF writer for tests.
+#![allow(dead_code)]
+
+#[path = "../../../roar-io/tests/common/gltf.rs"]
+pub mod gltf;
+
+use roar_cli::pipeline::ReconstructConfig;
+
+/// Few views, low resolutions, few iterations (as `reconstruct_small` uses), at `faces`.
+pub fn toy_config(faces: usize, iterations: usize) -> ReconstructConfig {
+    ReconstructConfig {
+        faces,
+        iterations,
+        init_resolution: 32,
+        init_max_faces: 4000,
+        working_budget_min: 600,
+        views_per_axis: 2,
+        render_resolution: 64,
+        point_cloud_samples: 5000,
+        sharp_edge_samples: 1000,
+        planar_max_samples: 5000,
+        split_interval: 3,
+        smoothing_interval: 2,
+        ..ReconstructConfig::default()
+    }
+}
