@@ -9,6 +9,7 @@ pub mod collapse_block;
 pub mod data_flips;
 pub mod degenerate;
 pub mod flips;
+pub mod genus;
 pub mod geometry;
 pub mod guard;
 pub mod init;
