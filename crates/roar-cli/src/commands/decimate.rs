@@ -1,10 +1,13 @@
-//! `roar decimate INPUT -o OUTPUT --faces N [--best-effort]`: the guaranteed QEM. The input must
-//! be a closed 2-manifold; the output keeps its genus and components, has exactly N faces and no
-//! new self-intersections, or the command fails saying how close it got.
+//! `roar decimate INPUT -o OUTPUT --faces N [--best-effort] [--reduce-genus]`: the guaranteed
+//! QEM. The input must be a closed 2-manifold; the output keeps its genus and components, has
+//! exactly N faces and no new self-intersections, or the command fails saying how close it got.
+//! With `--reduce-genus` handles are removed (shortest loop first, `roar_ops::genus`) when the
+//! genus needs more faces than N or the QEM stalls; components are still kept.
 
 use std::path::PathBuf;
 
 use clap::Args;
+use roar_ops::genus::{HandleRemovalOptions, decimate_removing_handles};
 use roar_ops::qem::{DecimateOptions, decimate_in_parallel};
 
 use crate::input::{read_closed_mesh, write_mesh};
@@ -23,6 +26,10 @@ pub struct DecimateArgs {
     /// When the vetoes block the budget, write the closest mesh instead of failing.
     #[arg(long)]
     pub best_effort: bool,
+    /// Remove handles (shortest loop first) when the genus needs more faces than N or the
+    /// decimation stalls, instead of failing.
+    #[arg(long)]
+    pub reduce_genus: bool,
 }
 
 /// Runs `roar decimate`.
@@ -32,7 +39,24 @@ pub fn run(args: &DecimateArgs) -> anyhow::Result<()> {
         best_effort: args.best_effort,
         ..DecimateOptions::default()
     };
-    let stats = decimate_in_parallel(&mut mesh, args.faces, &options)?;
+    let stats = if args.reduce_genus {
+        let (stats, removed) = decimate_removing_handles(
+            &mut mesh,
+            args.faces,
+            &options,
+            &HandleRemovalOptions::default(),
+            decimate_in_parallel,
+        )?;
+        for handle in &removed {
+            eprintln!(
+                "note: removed a handle (cut along a loop of {} edges, length {:.4})",
+                handle.loop_vertices, handle.loop_length
+            );
+        }
+        stats
+    } else {
+        decimate_in_parallel(&mut mesh, args.faces, &options)?
+    };
     write_mesh(&args.output, &mesh)?;
     if stats.reached_target {
         eprintln!(

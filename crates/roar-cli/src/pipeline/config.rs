@@ -176,6 +176,10 @@ pub struct ReconstructConfig {
     pub sliver_quality: f64,
     /// Write the closest mesh when the final QEM cannot reach the budget, instead of failing.
     pub best_effort: bool,
+    /// Keep the init's genus to the end: when the budget is too small for it (or the final QEM
+    /// stalls on the link condition) the run fails with the QEM's named error instead of
+    /// removing handles (`roar_ops::genus`; DESIGN.md §2).
+    pub keep_topology: bool,
 }
 
 impl Default for ReconstructConfig {
@@ -222,6 +226,7 @@ impl Default for ReconstructConfig {
             polish_iterations: 20,
             sliver_quality: 10.0,
             best_effort: false,
+            keep_topology: false,
         }
     }
 }

@@ -32,6 +32,9 @@ use roar_ops::collapse_block::{FaceCollapse, FaceCollapseOptions};
 use roar_ops::data_flips::{DataFlipOptions, flip_toward_target};
 use roar_ops::degenerate::{DegenerateOptions, collapse_degenerate_faces};
 use roar_ops::flips::FlipOptions;
+use roar_ops::genus::{
+    HandleRemovalOptions, ReduceGenusError, RemovedHandle, decimate_removing_handles,
+};
 use roar_ops::geometry::{DEGENERATE_QUALITY, is_degenerate, triangle_quality};
 use roar_ops::init::{InitError, InitOptions, InitialMeshOptions};
 use roar_ops::optim::{Optimizer, OptimizerOptions};
@@ -65,6 +68,9 @@ pub enum PipelineError {
     /// Self-intersections survived the untangle block.
     #[error("{0} faces still intersect after the untangle block")]
     Intersections(usize),
+    /// The budget is below a tetrahedron per piece, or a handle could not be cut.
+    #[error("{0}")]
+    Genus(#[from] ReduceGenusError),
 }
 
 /// What the pipeline hands to a loss factory.
@@ -178,6 +184,9 @@ pub struct RunStats {
     /// Edge collapses that removed degenerate faces no flip could, each followed by an edge
     /// split to keep the face count (0 also when undone, as `sliver_flips`).
     pub degenerate_collapses: usize,
+    /// Handles the finish removed so the budget could be met (shortest loop first, in order;
+    /// empty with `keep_topology`): the output's genus is `init_genus` minus their number.
+    pub handles_removed: Vec<RemovedHandle>,
 }
 
 /// One iteration of the optimize stage, as the report lists it.
@@ -366,7 +375,7 @@ impl Reconstruction {
                 stats.offset_vertices += offset_outward(&mut mesh, config.final_qem_offset);
                 clock.lap("offset");
             }
-            let decimated = final_decimation(&mut mesh, faces, config.best_effort)?;
+            let decimated = final_decimation(&mut mesh, faces, &config, &mut stats)?;
             stats.final_collapses += decimated.collapses;
             clock.lap("final_qem");
 
@@ -899,25 +908,48 @@ fn finish_budgets(faces: usize, budget: usize, polishing: bool) -> Vec<usize> {
     }
 }
 
-/// The guaranteed QEM to exactly `faces` (best effort only if configured).
+/// The guaranteed QEM to exactly `faces` (best effort only if configured). Unless
+/// `keep_topology`, handles are removed (shortest loop first, `roar_ops::genus`) when the genus
+/// needs more faces than `faces` or the QEM stalls above it; each removal is noted on stderr and
+/// recorded in `stats.handles_removed`.
 fn final_decimation(
     mesh: &mut Mesh,
     faces: usize,
-    best_effort: bool,
+    config: &ReconstructConfig,
+    stats: &mut RunStats,
 ) -> Result<DecimateStats, PipelineError> {
     let options = DecimateOptions {
-        best_effort,
+        best_effort: config.best_effort,
         ..DecimateOptions::default()
     };
-    let stats = decimate(mesh, faces, &options)?;
-    if mesh.n_faces() != faces && !best_effort {
+    let decimated = if config.keep_topology {
+        decimate(mesh, faces, &options)?
+    } else {
+        let (decimated, removed) = decimate_removing_handles(
+            mesh,
+            faces,
+            &options,
+            &HandleRemovalOptions::default(),
+            decimate,
+        )?;
+        for handle in &removed {
+            eprintln!(
+                "note: removed a handle to reach {faces} faces (cut along a loop of {} edges, \
+                 length {:.4} in the unit sphere; --keep-topology fails instead)",
+                handle.loop_vertices, handle.loop_length
+            );
+        }
+        stats.handles_removed.extend(removed);
+        decimated
+    };
+    if mesh.n_faces() != faces && !config.best_effort {
         return Err(PipelineError::Internal(format!(
             "the output has {} faces instead of {}",
             mesh.n_faces(),
             faces
         )));
     }
-    Ok(stats)
+    Ok(decimated)
 }
 
 fn record_untangle(stats: &mut RunStats, untangled: &UntangleStats) {
