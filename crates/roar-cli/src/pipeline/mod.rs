@@ -129,8 +129,11 @@ pub struct RunStats {
     pub init_faces: usize,
     /// Components (pieces) of M0.
     pub init_components: usize,
-    /// Genus of M0 (kept to the end).
+    /// Genus of M0 (kept to the end unless `handles_removed` says otherwise).
     pub init_genus: usize,
+    /// Voxels the init's winding-number rule turned solid (punctures closed;
+    /// `roar_ops::init::InitOptions::enclosure_winding_threshold`).
+    pub init_voxels_filled_by_winding: usize,
     /// The working budget W.
     pub working_budget: usize,
     /// Loss at the first and last iteration.
@@ -531,6 +534,7 @@ fn initial_mesh(
             let (mesh, init_stats) =
                 roar_ops::init::initial_mesh(&target.positions, &target.triangles, &options)?;
             stats.init_voxel_faces = init_stats.init_faces;
+            stats.init_voxels_filled_by_winding = init_stats.init.voxels_filled_by_winding;
             mesh
         }
         InitKind::Sphere => {
