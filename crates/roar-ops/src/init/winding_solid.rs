@@ -58,8 +58,9 @@ pub(crate) fn fill_enclosed(
     soup: &[[DVec3; 3]],
     threshold: f64,
 ) -> EnclosedFill {
-    let positions: Vec<DVec3> = soup.iter().flatten().copied().collect();
-    let triangles: Vec<[u32; 3]> = (0..soup.len() as u32)
+    let oriented = first_of_each_twin_pair(soup);
+    let positions: Vec<DVec3> = oriented.iter().flatten().copied().collect();
+    let triangles: Vec<[u32; 3]> = (0..oriented.len() as u32)
         .map(|f| [3 * f, 3 * f + 1, 3 * f + 2])
         .collect();
     let Ok(winding) = WindingNumber::build(&positions, &triangles) else {
@@ -98,6 +99,26 @@ pub(crate) fn fill_enclosed(
         evaluated: candidates.len(),
         filled: after - before,
     }
+}
+
+/// `soup` without the second of each pair of twins (the same corners in the other orientation).
+///
+/// A triangle and its twin cancel in the winding number, and the pipeline's target T′ keeps both
+/// twins of every pair its pixel-count rule leaves undecided, which on a punctured closed
+/// surface is most faces (their inner side is seen through the holes): with both, `w` is 0
+/// everywhere. The first of a pair is the input's own orientation (T′ lists the face before its
+/// twin), or the twin when the rule dropped the face.
+fn first_of_each_twin_pair(soup: &[[DVec3; 3]]) -> Vec<[DVec3; 3]> {
+    let key = |t: &[DVec3; 3]| {
+        let mut corners = t.map(|p| p.to_array().map(f64::to_bits));
+        corners.sort_unstable();
+        corners
+    };
+    let mut seen = std::collections::HashSet::with_capacity(soup.len());
+    soup.iter()
+        .filter(|t| seen.insert(key(t)))
+        .copied()
+        .collect()
 }
 
 fn bounds(points: &[DVec3]) -> (DVec3, DVec3) {
@@ -163,6 +184,18 @@ mod tests {
         let fill = fill_enclosed(&grid, &mut state, &closed, 0.6);
         assert_eq!(fill.filled, 0);
         assert_eq!(state, reference);
+    }
+
+    #[test]
+    fn twins_do_not_cancel_the_winding_number() {
+        // The open-topped box with every face also in the other orientation, as T′ keeps
+        // undecided twin pairs: the cup still fills.
+        let grid = Grid::around(DVec3::ZERO, DVec3::ONE, 12, 3);
+        let mut doubled = box_soup(DVec3::ZERO, DVec3::ONE, true);
+        let twins: Vec<[DVec3; 3]> = doubled.iter().map(|t| [t[0], t[2], t[1]]).collect();
+        doubled.extend(twins);
+        let mut state = flooded(&grid, &doubled);
+        assert!(fill_enclosed(&grid, &mut state, &doubled, 0.6).filled > 0);
     }
 
     #[test]
