@@ -35,8 +35,9 @@ pub fn min_reachable_budget(pieces: usize) -> usize {
 /// Options of [`remove_handles`].
 #[derive(Clone, Debug, PartialEq)]
 pub struct HandleRemovalOptions {
-    /// Root vertices tried per removal (spread evenly over the vertex order). More roots find
-    /// shorter loops at a proportional cost (one Dijkstra and one dual tree each).
+    /// Root vertices tried per removal in every component that has a handle (spread evenly over
+    /// its vertex order). More roots find shorter loops at a proportional cost (one Dijkstra
+    /// and one dual tree each).
     pub roots: usize,
 }
 
@@ -170,15 +171,27 @@ fn remove_one_handle(
     let (positions, triangles) = mesh.to_triangles();
     let compact = Mesh::from_triangles(positions.clone(), &triangles)
         .map_err(|e| HandleRemovalError::Internal(e.to_string()))?;
-    let n = compact.n_vertices();
-    let roots = options.roots.clamp(1, n);
-    let mut best: Option<(f64, Vec<u32>)> = None;
-    for r in 0..roots {
-        let root = (r * n / roots) as u32;
-        if let Some((length, cycle)) = shortest_generator_loop(&compact, root)
-            && best.as_ref().is_none_or(|(l, _)| length < *l)
+    // Roots spread over the vertices of every component that has a handle.
+    let (pieces, labels) = compact.components();
+    let genera = compact.component_genera();
+    let mut members: Vec<Vec<u32>> = vec![Vec::new(); pieces];
+    for (v, label) in labels.iter().enumerate() {
+        if let Some(c) = label
+            && genera[*c as usize] > 0
         {
-            best = Some((length, cycle));
+            members[*c as usize].push(v as u32);
+        }
+    }
+    let mut best: Option<(f64, Vec<u32>)> = None;
+    for vertices in members.iter().filter(|m| !m.is_empty()) {
+        let roots = options.roots.clamp(1, vertices.len());
+        for r in 0..roots {
+            let root = vertices[r * vertices.len() / roots];
+            if let Some((length, cycle)) = shortest_generator_loop(&compact, root)
+                && best.as_ref().is_none_or(|(l, _)| length < *l)
+            {
+                best = Some((length, cycle));
+            }
         }
     }
     let Some((length, cycle)) = best else {
