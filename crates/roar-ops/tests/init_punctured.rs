@@ -31,7 +31,11 @@ fn delete_random_faces(soup: &Soup, fraction: f64, seed: u64) -> Soup {
     let mut order: Vec<usize> = (0..soup.triangles.len()).collect();
     order.shuffle(&mut rng);
     let remove = (fraction * soup.triangles.len() as f64).round() as usize;
-    let gone: HashSet<usize> = order[..remove].iter().copied().collect();
+    without(soup, &order[..remove].iter().copied().collect())
+}
+
+/// `soup` without the faces in `gone`.
+fn without(soup: &Soup, gone: &HashSet<usize>) -> Soup {
     Soup {
         positions: soup.positions.clone(),
         triangles: (0..soup.triangles.len())
@@ -57,13 +61,7 @@ fn punch_small_holes(soup: &Soup, holes: usize, seed: u64) -> Soup {
         let v = soup.triangles[f][rng.random_range(0..3)];
         gone.extend(by_vertex[&v].iter().copied());
     }
-    Soup {
-        positions: soup.positions.clone(),
-        triangles: (0..soup.triangles.len())
-            .filter(|f| !gone.contains(f))
-            .map(|f| soup.triangles[f])
-            .collect(),
-    }
+    without(soup, &gone)
 }
 
 fn init_with(soup: &Soup, resolution: usize, threshold: Option<f64>) -> WatertightInit {
