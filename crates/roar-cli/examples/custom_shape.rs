@@ -66,7 +66,11 @@ impl Shape for AnalyticTorus {
         // have the torus's genus: no operator of the loop changes the topology.
         let mesh = self.mesh(24, 12, 1.2);
         let raw_faces = mesh.n_faces();
-        Ok(InitialMesh { mesh, raw_faces })
+        Ok(InitialMesh {
+            mesh,
+            raw_faces,
+            voxels_filled_by_winding: 0,
+        })
     }
 
     fn point_cloud(&self, _initial: &Mesh) -> Result<PointCloud, ShapeError> {

@@ -1,16 +1,21 @@
 //! Face budgets a user may ask for, known before any work: a closed triangle mesh has an even face
 //! count (3F = 2E), and each closed piece needs at least the faces of the smallest triangulation
 //! of its genus (4 for a sphere, 14 for a torus: `roar_ops::decimate::minimum_faces_for_genus`).
-//! Every operator keeps the pieces and their genera, so this is the smallest budget a run can
-//! reach; the one place to change when the finish learns to remove handles.
+//! Every operator keeps the pieces; the genera too, unless handles may be removed (the finish's
+//! `roar_ops::finish::genus`), which brings the smallest budget down to a tetrahedron per piece.
 
 use roar_ops::decimate::minimum_faces_for_genus;
 
-/// The smallest face count a closed mesh with pieces of these genera can be decimated to while
-/// keeping its topology: the sum of each piece's minimum (`2(V − 2 + 2g)` with Heawood's vertex
-/// bound). 0 pieces → 0.
-pub fn min_reachable_budget(genera: &[usize]) -> usize {
-    genera.iter().copied().map(minimum_faces_for_genus).sum()
+/// The smallest face count a closed mesh with pieces of these genera can be decimated to: with
+/// `keep_topology`, the sum of each piece's minimum (`2(V − 2 + 2g)` with Heawood's vertex
+/// bound); otherwise handles may be removed and each piece needs a tetrahedron's 4 faces
+/// (`roar_ops::finish::genus::min_reachable_budget`). 0 pieces → 0.
+pub fn min_reachable_budget(genera: &[usize], keep_topology: bool) -> usize {
+    if keep_topology {
+        genera.iter().copied().map(minimum_faces_for_genus).sum()
+    } else {
+        roar_ops::finish::genus::min_reachable_budget(genera.len())
+    }
 }
 
 /// Checks `faces` against the smallest budget `minimum` (even, ≥ 4) before any work; the error
@@ -83,11 +88,13 @@ mod tests {
 
     #[test]
     fn smallest_budgets_of_spheres_tori_and_several_pieces() {
-        assert_eq!(min_reachable_budget(&[0]), 4);
-        assert_eq!(min_reachable_budget(&[1]), 14);
-        assert_eq!(min_reachable_budget(&[0, 0]), 8);
-        assert_eq!(min_reachable_budget(&[0, 1]), 18);
-        assert_eq!(min_reachable_budget(&[]), 0);
+        assert_eq!(min_reachable_budget(&[0], true), 4);
+        assert_eq!(min_reachable_budget(&[1], true), 14);
+        assert_eq!(min_reachable_budget(&[1], false), 4);
+        assert_eq!(min_reachable_budget(&[2, 0], false), 8);
+        assert_eq!(min_reachable_budget(&[0, 0], true), 8);
+        assert_eq!(min_reachable_budget(&[0, 1], true), 18);
+        assert_eq!(min_reachable_budget(&[], true), 0);
     }
 
     #[test]

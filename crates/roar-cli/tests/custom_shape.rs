@@ -92,7 +92,11 @@ impl Shape for AnalyticSphere {
             *p *= 0.9 * RIG_RADIUS;
         }
         let raw_faces = mesh.n_faces();
-        Ok(InitialMesh { mesh, raw_faces })
+        Ok(InitialMesh {
+            mesh,
+            raw_faces,
+            voxels_filled_by_winding: 0,
+        })
     }
 
     fn point_cloud(&self, _initial: &Mesh) -> Result<PointCloud, ShapeError> {

@@ -95,6 +95,7 @@ fn the_flag_refuses_a_non_png_name_before_any_work() {
         print_config: false,
         quiet: true,
         force: false,
+        keep_topology: false,
     };
     let message = roar_cli::commands::reconstruct::run(&args)
         .unwrap_err()

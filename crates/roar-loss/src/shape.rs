@@ -45,6 +45,9 @@ pub struct InitialMesh {
     /// Faces of the shape's raw init before it was decimated (the voxel surface of a soup's
     /// watertight init; `mesh.n_faces()` when nothing was decimated). For reports.
     pub raw_faces: usize,
+    /// Voxels of a soup's watertight init that the enclosure rule (generalized winding number)
+    /// made solid; 0 for other kinds of init. For reports.
+    pub voxels_filled_by_winding: usize,
 }
 
 /// Figures about a shape's own preparation, for reports (zeros where a kind has no such thing).

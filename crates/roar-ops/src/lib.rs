@@ -10,7 +10,7 @@
 //! | loop: Move Vertices | [`optim`] | the optimizer, its per-vertex state and how that state follows the mesh |
 //! | loop: remeshing | [`blocks`] | the `Block` trait; Face Collapse, flips, Face Split, smoothing; candidate selection, edge costs, the intersection guard |
 //! | loop and finish | [`untangle`] | the step limiter and the untangle block |
-//! | finish | [`finish`] | fill to the budget, outward offset, data flips, sliver flips, degenerate collapses |
+//! | finish | [`finish`] | fill to the budget, outward offset, handle removal when the budget needs it, data flips, sliver flips, degenerate collapses |
 //!
 //! Shared by several stages: [`geometry`] (per-mesh normals, quality measures) and a private
 //! exact face–face intersection test. Dependencies run down this table's stages and into the

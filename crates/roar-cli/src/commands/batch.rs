@@ -230,6 +230,7 @@ fn reconstruct_args(
         quiet: true,
         force: false,
         preview: None,
+        keep_topology: false,
     }
 }
 

@@ -1,11 +1,14 @@
-//! `roar decimate INPUT -o OUTPUT --faces N [--best-effort]`: the guaranteed QEM. The input must
-//! be a closed 2-manifold; the output keeps its genus and components, has exactly N faces and no
-//! new self-intersections, or the command fails saying how close it got.
+//! `roar decimate INPUT -o OUTPUT --faces N [--best-effort] [--reduce-genus]`: the guaranteed
+//! QEM. The input must be a closed 2-manifold; the output keeps its genus and components, has
+//! exactly N faces and no new self-intersections, or the command fails saying how close it got.
+//! With `--reduce-genus` handles are removed (shortest loop first, `roar_ops::finish::genus`) when the
+//! genus needs more faces than N or the QEM stalls; components are still kept.
 
 use std::path::PathBuf;
 
 use clap::Args;
 use roar_ops::decimate::{DecimateOptions, decimate_in_parallel};
+use roar_ops::finish::genus::{HandleRemovalOptions, decimate_removing_handles};
 
 use crate::budget::{check_budget, min_reachable_budget, parse_faces};
 use crate::checks::check_paths;
@@ -26,6 +29,10 @@ pub struct DecimateArgs {
     /// status is 0 and the message says how close it got).
     #[arg(long)]
     pub best_effort: bool,
+    /// Remove handles (shortest loop first) when the genus needs more faces than N or the
+    /// decimation stalls, instead of failing.
+    #[arg(long)]
+    pub reduce_genus: bool,
 }
 
 /// Runs `roar decimate`.
@@ -37,7 +44,7 @@ pub struct DecimateArgs {
 pub fn run(args: &DecimateArgs) -> anyhow::Result<()> {
     check_paths(&[("INPUT", &args.input)], &[("-o", &args.output)])?;
     let mut mesh = read_closed_mesh(&args.input)?;
-    let minimum = min_reachable_budget(&mesh.component_genera());
+    let minimum = min_reachable_budget(&mesh.component_genera(), !args.reduce_genus);
     check_budget("--faces", args.faces, minimum).map_err(anyhow::Error::msg)?;
     if args.faces > mesh.n_faces() {
         anyhow::bail!(
@@ -52,7 +59,24 @@ pub fn run(args: &DecimateArgs) -> anyhow::Result<()> {
         best_effort: args.best_effort,
         ..DecimateOptions::default()
     };
-    let stats = decimate_in_parallel(&mut mesh, args.faces, &options)?;
+    let stats = if args.reduce_genus {
+        let (stats, removed) = decimate_removing_handles(
+            &mut mesh,
+            args.faces,
+            &options,
+            &HandleRemovalOptions::default(),
+            decimate_in_parallel,
+        )?;
+        for handle in &removed {
+            eprintln!(
+                "note: removed a handle (cut along a loop of {} edges, length {:.4})",
+                handle.loop_vertices, handle.loop_length
+            );
+        }
+        stats
+    } else {
+        decimate_in_parallel(&mut mesh, args.faces, &options)?
+    };
     let reached = mesh.n_faces() == args.faces;
     write_mesh(&args.output, &mesh)?;
     if reached {

@@ -44,13 +44,15 @@ pub fn run(args: &InitArgs) -> anyhow::Result<()> {
         .with_context(|| format!("{}: watertight init failed", args.input.display()))?;
     write_mesh(&args.output, &mesh)?;
     eprintln!(
-        "wrote {}: {} faces ({} before decimation), {} piece(s), {} dropped, genus {}",
+        "wrote {}: {} faces ({} before decimation), {} piece(s), {} dropped, genus {}, {} voxels \
+         closed by the winding number",
         args.output.display(),
         mesh.n_faces(),
         stats.init_faces,
         stats.init.pieces,
         stats.init.dropped_pieces,
-        mesh.genus()
+        mesh.genus(),
+        stats.init.voxels_filled_by_winding
     );
     Ok(())
 }

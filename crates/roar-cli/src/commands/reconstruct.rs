@@ -44,6 +44,9 @@ pub struct ReconstructArgs {
     /// Write the closest mesh if the budget cannot be met, instead of failing.
     #[arg(long)]
     pub best_effort: bool,
+    /// Keep the genus: fail when the budget is too small for it instead of removing handles.
+    #[arg(long)]
+    pub keep_topology: bool,
     /// Also write the JSON report to this file.
     #[arg(long)]
     pub report: Option<PathBuf>,
@@ -252,6 +255,9 @@ pub fn effective_config(args: &ReconstructArgs) -> anyhow::Result<ReconstructCon
     }
     if args.best_effort {
         config.best_effort = true;
+    }
+    if args.keep_topology {
+        config.keep_topology = true;
     }
     Ok(config)
 }

@@ -37,6 +37,14 @@ pub struct ReconstructConfig {
     pub init_resolution: usize,
     /// The init is decimated to at most this many faces (§4.1: 20k).
     pub init_max_faces: usize,
+    /// Enclosure rule of the watertight init (`roar_ops::init::winding_solid`; 0 = off, the
+    /// default): exterior voxels whose generalized winding number with respect to T′ is above
+    /// this value turn solid, so punctures of a closed surface close while tunnels stay (the
+    /// measured value is `roar_ops::init::ENCLOSURE_WINDING_THRESHOLD` = 0.7). Off by default
+    /// because it also fills open surfaces with a wide opening: at init + QEM to 1000 faces it
+    /// took gpytoolbox-airplane's Chamfer/diag from 2.06e-3 to 1.26e-3 but libigl-camelhead's
+    /// from 2.36e-3 to 3.74e-3 (`docs/evaluation.md`, "Punctured inputs").
+    pub enclosure_winding_threshold: f64,
     /// Subdivision level of the sphere init (§4.2: 2; more helps a sphere reach detail).
     pub sphere_level: u32,
     /// Working budget W = clamp(factor·N, min, max), never below N (OQ-11, §1.2 step 6).
@@ -177,6 +185,10 @@ pub struct ReconstructConfig {
     pub sliver_quality: f64,
     /// Write the closest mesh when the final QEM cannot reach the budget, instead of failing.
     pub best_effort: bool,
+    /// Keep the init's genus to the end: when the budget is too small for it (or the final QEM
+    /// stalls on the link condition) the run fails with the QEM's named error instead of
+    /// removing handles (`roar_ops::finish::genus`; DESIGN.md §2).
+    pub keep_topology: bool,
 }
 
 impl Default for ReconstructConfig {
@@ -188,6 +200,7 @@ impl Default for ReconstructConfig {
             init: InitKind::Watertight,
             init_resolution: 192,
             init_max_faces: 20_000,
+            enclosure_winding_threshold: 0.0,
             sphere_level: 4,
             working_budget_factor: 2,
             working_budget_min: 5000,
@@ -223,6 +236,7 @@ impl Default for ReconstructConfig {
             polish_iterations: 20,
             sliver_quality: 10.0,
             best_effort: false,
+            keep_topology: false,
         }
     }
 }
@@ -277,6 +291,10 @@ impl ReconstructConfig {
                 self.init_resolution as f64,
             ),
             (r("init_max_faces", 4.0, 1e7), self.init_max_faces as f64),
+            (
+                off("enclosure_winding_threshold", 0.5, 1.0),
+                self.enclosure_winding_threshold,
+            ),
             (r("sphere_level", 0.0, 8.0), f64::from(self.sphere_level)),
             (
                 r("working_budget_factor", 1.0, 100.0),

@@ -40,6 +40,9 @@ use roar_ops::decimate::{DecimateError, DecimateOptions, DecimateStats, decimate
 use roar_ops::finish::data_flips::{DataFlipOptions, flip_toward_target};
 use roar_ops::finish::degenerate::{DegenerateOptions, collapse_degenerate_faces};
 use roar_ops::finish::fill::fill_to_budget;
+use roar_ops::finish::genus::{
+    HandleRemovalOptions, ReduceGenusError, RemovedHandle, decimate_removing_handles,
+};
 use roar_ops::finish::offset::offset_outward;
 use roar_ops::finish::slivers::{SliverOptions, flip_slivers};
 use roar_ops::init::InitError;
@@ -78,6 +81,9 @@ pub enum PipelineError {
     /// [`Reconstruction::cancel`] was set; the run stopped at its next progress report.
     #[error("cancelled")]
     Cancelled,
+    /// The budget is below a tetrahedron per piece, or a handle could not be cut.
+    #[error("{0}")]
+    Genus(#[from] ReduceGenusError),
 }
 
 /// What the pipeline hands to a loss factory: what the input [`Shape`] gave, in rig
@@ -141,8 +147,11 @@ pub struct RunStats {
     pub init_faces: usize,
     /// Components (pieces) of M0.
     pub init_components: usize,
-    /// Genus of M0 (kept to the end).
+    /// Genus of M0 (kept to the end unless `handles_removed` says otherwise).
     pub init_genus: usize,
+    /// Voxels the init's winding-number rule turned solid (punctures closed;
+    /// `roar_ops::init::InitOptions::enclosure_winding_threshold`).
+    pub init_voxels_filled_by_winding: usize,
     /// The working budget W.
     pub working_budget: usize,
     /// Loss at the first and last iteration.
@@ -196,6 +205,9 @@ pub struct RunStats {
     /// Edge collapses that removed degenerate faces no flip could, each followed by an edge
     /// split to keep the face count (0 also when undone, as `sliver_flips`).
     pub degenerate_collapses: usize,
+    /// Handles the finish removed so the budget could be met (shortest loop first, in order;
+    /// empty with `keep_topology`): the output's genus is `init_genus` minus their number.
+    pub handles_removed: Vec<RemovedHandle>,
 }
 
 /// One iteration of the optimize stage, as the report lists it.
@@ -298,7 +310,7 @@ impl Reconstruction {
         crate::budget::check_budget(
             "faces =",
             config.faces,
-            crate::budget::min_reachable_budget(&mesh.component_genera()),
+            crate::budget::min_reachable_budget(&mesh.component_genera(), config.keep_topology),
         )
         .map_err(|e| PipelineError::Config(format!("{e} (for the pieces of the init)")))?;
         clock.lap("init");
@@ -435,7 +447,7 @@ impl Reconstruction {
                 stats.offset_vertices += offset_outward(&mut mesh, config.final_qem_offset);
                 clock.lap("offset");
             }
-            let decimated = final_decimation(&mut mesh, faces, config.best_effort)?;
+            let decimated = final_decimation(&mut mesh, faces, &config, &mut stats)?;
             stats.final_collapses += decimated.collapses;
             clock.lap("final_qem");
 
@@ -594,6 +606,7 @@ fn initial_mesh(
         InitKind::Watertight => {
             let initial = shape.initial_mesh()?;
             stats.init_voxel_faces = initial.raw_faces;
+            stats.init_voxels_filled_by_winding = initial.voxels_filled_by_winding;
             initial.mesh
         }
         InitKind::Sphere => {
@@ -867,25 +880,48 @@ fn finish_budgets(faces: usize, budget: usize, polishing: bool) -> Vec<usize> {
     }
 }
 
-/// The guaranteed QEM to exactly `faces` (best effort only if configured).
+/// The guaranteed QEM to exactly `faces` (best effort only if configured). Unless
+/// `keep_topology`, handles are removed (shortest loop first, `roar_ops::finish::genus`) when the genus
+/// needs more faces than `faces` or the QEM stalls above it; each removal is noted on stderr and
+/// recorded in `stats.handles_removed`.
 fn final_decimation(
     mesh: &mut Mesh,
     faces: usize,
-    best_effort: bool,
+    config: &ReconstructConfig,
+    stats: &mut RunStats,
 ) -> Result<DecimateStats, PipelineError> {
     let options = DecimateOptions {
-        best_effort,
+        best_effort: config.best_effort,
         ..DecimateOptions::default()
     };
-    let stats = decimate(mesh, faces, &options)?;
-    if mesh.n_faces() != faces && !best_effort {
+    let decimated = if config.keep_topology {
+        decimate(mesh, faces, &options)?
+    } else {
+        let (decimated, removed) = decimate_removing_handles(
+            mesh,
+            faces,
+            &options,
+            &HandleRemovalOptions::default(),
+            decimate,
+        )?;
+        for handle in &removed {
+            eprintln!(
+                "note: removed a handle to reach {faces} faces (cut along a loop of {} edges, \
+                 length {:.4} in the unit sphere; --keep-topology fails instead)",
+                handle.loop_vertices, handle.loop_length
+            );
+        }
+        stats.handles_removed.extend(removed);
+        decimated
+    };
+    if mesh.n_faces() != faces && !config.best_effort {
         return Err(PipelineError::Internal(format!(
             "the output has {} faces instead of {}",
             mesh.n_faces(),
             faces
         )));
     }
-    Ok(stats)
+    Ok(decimated)
 }
 
 fn record_untangle(stats: &mut RunStats, untangled: &UntangleStats) {

@@ -97,6 +97,8 @@ impl Shape for SoupShape<'_> {
         let options = InitialMeshOptions {
             init: InitOptions {
                 resolution: self.config.init_resolution,
+                enclosure_winding_threshold: (self.config.enclosure_winding_threshold > 0.0)
+                    .then_some(self.config.enclosure_winding_threshold),
                 ..InitOptions::default()
             },
             max_faces: self.config.init_max_faces,
@@ -108,6 +110,7 @@ impl Shape for SoupShape<'_> {
         Ok(InitialMesh {
             mesh,
             raw_faces: stats.init_faces,
+            voxels_filled_by_winding: stats.init.voxels_filled_by_winding,
         })
     }
 

@@ -1,0 +1,213 @@
+//! Inside versus outside despite holes: the generalized winding number of the soup decides which
+//! voxels the exterior flood reached only through a puncture.
+//!
+//! The flood fill of module `solid` calls every voxel the grid border reaches *exterior*. A closed
+//! surface with punctures (missing faces wider than the one-voxel gap closing) lets the flood into
+//! its inside, and the init then becomes a thin shell around the surface with one handle per
+//! puncture. The generalized winding number `w` of the soup (Jacobson et al. 2013; the fast
+//! evaluation of `roar_mesh::spatial::WindingNumber`) tells the two apart: inside a punctured
+//! closed, consistently oriented surface `w` stays near 1 whatever the holes' sizes (a hole only
+//! removes its own solid angle), outside it stays near 0, and across a hole it falls from 1 to 0,
+//! so the level set `w = threshold` caps the hole. Inside a real tunnel (a torus's hole, a mug's
+//! handle) `w` is near 0, so tunnels stay open.
+//!
+//! **How the two rules combine.** The winding number only ever *adds* solid: a voxel is solid
+//! when the flood did not reach it (the thin-sheet rule of module `solid`), or when `w` at its
+//! centre is above the threshold; then the exterior is flooded again from the border, so pockets
+//! the new solid cuts off become solid too and the exterior stays one connected region. Open
+//! surfaces and zero-thickness sheets enclose nothing: one sheet's `w` stays inside
+//! `(−½, ½)`, so with a threshold above ½ it never adds a voxel and the sheet keeps the shell
+//! the flood gives it.
+//!
+//! **Where the rule fails.** (a) Inconsistently oriented soups: faces whose normals point
+//! inward cancel the outward ones, `w` inside drops below the threshold and the punctures of
+//! such a part stay open (the flood's shell is kept, so no part is lost, unlike a pure winding
+//! filter). (b) Several open sheets stacked with the same orientation add up past the threshold
+//! between them, and that gap fills. (c) A concave open sheet (a trough, a bowl) has `w` above ½
+//! on its hollow side, growing with its depth: a deep bowl fills up to the level set, a shallow
+//! trough does not. (d) A hole whose width rivals the thickness of the part behind it (a face
+//! missing from a thin slab) lowers `w` across the whole part there and may stay a handle.
+//! (e) Holes narrower than a voxel are closed by the
+//! flood's gap closing already; the winding rule adds nothing there.
+
+use super::grid::{EXTERIOR, Grid, SOLID};
+use super::solid;
+use glam::DVec3;
+use roar_mesh::spatial::WindingNumber;
+
+/// What [`fill_enclosed`] did.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub(crate) struct EnclosedFill {
+    /// Exterior voxels whose winding number was evaluated.
+    pub evaluated: usize,
+    /// Voxels that turned solid (above the threshold, or cut off from the border by those).
+    pub filled: usize,
+}
+
+/// Turns solid every exterior voxel of `state` whose centre has a winding number (of `soup`)
+/// above `threshold`, then floods the exterior again from the border so that exterior voxels the
+/// new solid cut off turn solid too (see the module doc). Only voxels inside the soup's bounding
+/// box are evaluated: outside it the winding number of a closed surface is 0 and that of open
+/// sheets stays within `(−½, ½)`, so with `threshold ≥ ½` none of them would turn solid.
+///
+/// Promises: no solid voxel of `state` turns exterior; the exterior stays exactly the set of
+/// voxels the border reaches through exterior voxels.
+pub(crate) fn fill_enclosed(
+    grid: &Grid,
+    state: &mut Vec<u8>,
+    soup: &[[DVec3; 3]],
+    threshold: f64,
+) -> EnclosedFill {
+    let oriented = first_of_each_twin_pair(soup);
+    let positions: Vec<DVec3> = oriented.iter().flatten().copied().collect();
+    let triangles: Vec<[u32; 3]> = (0..oriented.len() as u32)
+        .map(|f| [3 * f, 3 * f + 1, 3 * f + 2])
+        .collect();
+    let Ok(winding) = WindingNumber::build(&positions, &triangles) else {
+        // Unreachable: the indices above are in range by construction.
+        return EnclosedFill::default();
+    };
+    let (lo, hi) = bounds(&positions);
+    let center = |idx: usize| grid.corner(grid.coords(idx)) + DVec3::splat(0.5 * grid.voxel_size);
+    let candidates: Vec<usize> = (0..grid.len())
+        .filter(|&idx| state[idx] == EXTERIOR && !grid.on_border(grid.coords(idx)))
+        .filter(|&idx| {
+            let c = center(idx);
+            c.cmpge(lo).all() && c.cmple(hi).all()
+        })
+        .collect();
+    let points: Vec<DVec3> = candidates.iter().map(|&idx| center(idx)).collect();
+    let values = winding.winding_numbers(&points);
+    let mut blocked: Vec<u8> = state.iter().map(|&s| u8::from(s == SOLID)).collect();
+    let mut above = 0;
+    for (&idx, &w) in candidates.iter().zip(&values) {
+        if w > threshold {
+            blocked[idx] = 1;
+            above += 1;
+        }
+    }
+    if above == 0 {
+        return EnclosedFill {
+            evaluated: candidates.len(),
+            filled: 0,
+        };
+    }
+    let before = state.iter().filter(|&&s| s == SOLID).count();
+    *state = solid::flood_exterior(grid, &blocked);
+    let after = state.iter().filter(|&&s| s == SOLID).count();
+    EnclosedFill {
+        evaluated: candidates.len(),
+        filled: after - before,
+    }
+}
+
+/// `soup` without the second of each pair of twins (the same corners in the other orientation).
+///
+/// A triangle and its twin cancel in the winding number, and the pipeline's target T′ keeps both
+/// twins of every pair its pixel-count rule leaves undecided, which on a punctured closed
+/// surface is most faces (their inner side is seen through the holes): with both, `w` is 0
+/// everywhere. The first of a pair is the input's own orientation (T′ lists the face before its
+/// twin), or the twin when the rule dropped the face.
+fn first_of_each_twin_pair(soup: &[[DVec3; 3]]) -> Vec<[DVec3; 3]> {
+    let key = |t: &[DVec3; 3]| {
+        let mut corners = t.map(|p| p.to_array().map(f64::to_bits));
+        corners.sort_unstable();
+        corners
+    };
+    let mut seen = std::collections::HashSet::with_capacity(soup.len());
+    soup.iter()
+        .filter(|t| seen.insert(key(t)))
+        .copied()
+        .collect()
+}
+
+fn bounds(points: &[DVec3]) -> (DVec3, DVec3) {
+    points.iter().fold(
+        (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)),
+        |(lo, hi), p| (lo.min(*p), hi.max(*p)),
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The six faces of the box `[lo, hi]` as outward triangles, optionally without the +z face.
+    fn box_soup(lo: DVec3, hi: DVec3, open_top: bool) -> Vec<[DVec3; 3]> {
+        let c = |x: usize, y: usize, z: usize| {
+            DVec3::new([lo.x, hi.x][x], [lo.y, hi.y][y], [lo.z, hi.z][z])
+        };
+        let quads = [
+            ([c(0, 0, 0), c(0, 1, 0), c(1, 1, 0), c(1, 0, 0)], false), // -z
+            ([c(0, 0, 1), c(1, 0, 1), c(1, 1, 1), c(0, 1, 1)], true),  // +z
+            ([c(0, 0, 0), c(1, 0, 0), c(1, 0, 1), c(0, 0, 1)], false), // -y
+            ([c(0, 1, 0), c(0, 1, 1), c(1, 1, 1), c(1, 1, 0)], false), // +y
+            ([c(0, 0, 0), c(0, 0, 1), c(0, 1, 1), c(0, 1, 0)], false), // -x
+            ([c(1, 0, 0), c(1, 1, 0), c(1, 1, 1), c(1, 0, 1)], false), // +x
+        ];
+        let mut soup = Vec::new();
+        for (q, top) in quads {
+            if top && open_top {
+                continue;
+            }
+            soup.push([q[0], q[1], q[2]]);
+            soup.push([q[0], q[2], q[3]]);
+        }
+        soup
+    }
+
+    fn flooded(grid: &Grid, soup: &[[DVec3; 3]]) -> Vec<u8> {
+        let marked = super::super::voxelize::mark_surface_voxels(grid, soup);
+        solid::flood_exterior(grid, &marked)
+    }
+
+    #[test]
+    fn an_open_topped_box_fills_and_a_closed_box_is_unchanged() {
+        let grid = Grid::around(DVec3::ZERO, DVec3::ONE, 12, 3);
+        let open = box_soup(DVec3::ZERO, DVec3::ONE, true);
+        let mut state = flooded(&grid, &open);
+        let solid_before = state.iter().filter(|&&s| s == SOLID).count();
+        let fill = fill_enclosed(&grid, &mut state, &open, 0.6);
+        assert!(fill.filled > 0);
+        // The inside of the cup (winding number about 0.8 at its centre) is solid now.
+        let mid = grid.to_grid(DVec3::new(0.5, 0.5, 0.3)).floor();
+        let idx = grid.index(mid.x as usize, mid.y as usize, mid.z as usize);
+        assert_eq!(state[idx], SOLID);
+        assert_eq!(
+            state.iter().filter(|&&s| s == SOLID).count(),
+            solid_before + fill.filled
+        );
+
+        let closed = box_soup(DVec3::ZERO, DVec3::ONE, false);
+        let mut state = flooded(&grid, &closed);
+        let reference = state.clone();
+        let fill = fill_enclosed(&grid, &mut state, &closed, 0.6);
+        assert_eq!(fill.filled, 0);
+        assert_eq!(state, reference);
+    }
+
+    #[test]
+    fn twins_do_not_cancel_the_winding_number() {
+        // The open-topped box with every face also in the other orientation, as T′ keeps
+        // undecided twin pairs: the cup still fills.
+        let grid = Grid::around(DVec3::ZERO, DVec3::ONE, 12, 3);
+        let mut doubled = box_soup(DVec3::ZERO, DVec3::ONE, true);
+        let twins: Vec<[DVec3; 3]> = doubled.iter().map(|t| [t[0], t[2], t[1]]).collect();
+        doubled.extend(twins);
+        let mut state = flooded(&grid, &doubled);
+        assert!(fill_enclosed(&grid, &mut state, &doubled, 0.6).filled > 0);
+    }
+
+    #[test]
+    fn a_single_sheet_adds_no_solid() {
+        // A slanted square, so that voxel centres lie inside its bounding box.
+        let grid = Grid::around(DVec3::ZERO, DVec3::new(1.0, 1.0, 0.3), 12, 3);
+        let (a, b) = (DVec3::new(1.0, 0.0, 0.3), DVec3::new(1.0, 1.0, 0.3));
+        let sheet = vec![[DVec3::ZERO, a, b], [DVec3::ZERO, b, DVec3::Y]];
+        let mut state = flooded(&grid, &sheet);
+        let reference = state.clone();
+        let fill = fill_enclosed(&grid, &mut state, &sheet, 0.6);
+        assert_eq!(fill.filled, 0);
+        assert_eq!(state, reference);
+    }
+}
