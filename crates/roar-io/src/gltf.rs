@@ -77,6 +77,26 @@ fn read_gltf_in(bytes: &[u8], name: &str, folder: Option<&Path>) -> Result<Trian
     // decoder below handles; the crate's validator refuses every extension it does not know.
     json.extensions_required
         .retain(|e| e.as_str() != "KHR_mesh_quantization");
+    // The crate's validator indexes the POSITION accessor before checking the index is in
+    // range (gltf-json 1.4.1, mesh.rs), so a broken index would panic there: check it first.
+    for (m, mesh) in json.meshes.iter().enumerate() {
+        for (p, primitive) in mesh.primitives.iter().enumerate() {
+            let position = primitive.attributes.iter().find_map(|(semantic, index)| {
+                matches!(
+                    semantic,
+                    gltf::json::validation::Checked::Valid(gltf::Semantic::Positions)
+                )
+                .then_some(index.value())
+            });
+            if let Some(index) = position
+                && index >= json.accessors.len()
+            {
+                return Err(err(format!(
+                    "mesh {m} primitive {p}: POSITION accessor {index} does not exist"
+                )));
+            }
+        }
+    }
     let document = gltf::Document::from_json(json)
         .map_err(|e| err(format!("invalid glTF: {}", one_line(&e.to_string()))))?;
 

@@ -304,6 +304,13 @@ fn broken_documents_are_refused_with_one_line() {
     b.add_scene(&[node]);
     assert_refused(&b.glb(), "runs past the end of buffer view");
 
+    // A POSITION accessor that does not exist (the crate's validator would index it).
+    let mut b = GltfBuilder::default();
+    let mesh = b.add_mesh(99, None, None);
+    let node = b.add_node(&format!(r#""mesh":{mesh}"#));
+    b.add_scene(&[node]);
+    assert_refused(&b.glb(), "POSITION accessor 99 does not exist");
+
     // A node that is its own child.
     let (mut b, mesh) = tetra_builder();
     let node = b.add_node(&format!(r#""mesh":{mesh},"children":[0]"#));
