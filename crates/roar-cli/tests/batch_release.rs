@@ -177,7 +177,7 @@ fn forty_items_in_four_shards_survive_a_killed_shard() {
         (
             TWO_FACES,
             3,
-            "faces = 2 is below the 4 faces of a tetrahedron",
+            "faces = 2 is below the smallest reachable budget, 4 faces",
         ),
     ] {
         let logged = failures(shard);
