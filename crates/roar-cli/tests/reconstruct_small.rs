@@ -10,22 +10,10 @@ use roar_mesh::spatial::self_intersecting_faces;
 use roar_ops::blocks::block::{Block, BlockContext, BlockStats};
 use roar_ops::optim::Optimizer;
 
+mod common;
+
 fn toy_config(faces: usize) -> ReconstructConfig {
-    ReconstructConfig {
-        faces,
-        iterations: 6,
-        init_resolution: 32,
-        init_max_faces: 4000,
-        working_budget_min: 600,
-        views_per_axis: 2,
-        render_resolution: 64,
-        point_cloud_samples: 5000,
-        sharp_edge_samples: 1000,
-        planar_max_samples: 5000,
-        split_interval: 3,
-        smoothing_interval: 2,
-        ..ReconstructConfig::default()
-    }
+    common::toy_config(faces, 6)
 }
 
 fn run(config: ReconstructConfig) -> (Vec<glam::DVec3>, Vec<[u32; 3]>, usize) {
