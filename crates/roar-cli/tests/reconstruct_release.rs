@@ -3,23 +3,14 @@
 //! 2-manifold with exactly the budget, no self-intersecting faces, no more components than the
 //! init, and a Chamfer distance below that of the init decimated to the same budget (what the
 //! optimization adds): at least 10 % below on trimesh-rabbit and luke-f-16, and not above it on
-//! the example: since the QEM has planar quadrics, the box-shaped init decimated to 1000 faces
-//! is already about as close as roar gets (this test's Chamfer/diag: 2.40e-3 against roar's
-//! 2.37e-3; it was 4.28e-3 before; the one-sided distances agree within 2 %: what is left is
-//! the sheet's thickness and the soup's interior faces, which no closed surface comes nearer
-//! to).
-//!
-//! Measured with the twelfth session's code (init at 192 voxels, the finish through 2N; in
-//! release): the example 2.40e-3 → 2.37e-3 (−1.1 %), trimesh-rabbit 2.87e-3 → 2.40e-3
-//! (−16.2 %), luke-f-16 1.64e-3 → 1.40e-3 (−14.6 %; −11.5 % with the eleventh session's
-//! one-step finish). With the sixth session's init at 128 voxels: trimesh-rabbit 3.31e-3 →
-//! 2.39e-3 (−27.8 %), luke-f-16 1.89e-3 → 1.51e-3 (−19.9 %): the finer init is closer to the
-//! input, so the optimization's margin over it is smaller.
+//! the example. Since the QEM has planar quadrics, the example's box-shaped init decimated to
+//! 1000 faces is already about as close as roar gets (Chamfer/diag 2.40e-3 against roar's
+//! 2.37e-3): what is left is the sheet's thickness and the soup's interior faces, which no
+//! closed surface comes nearer to. On the two wild meshes the margin is larger
+//! (trimesh-rabbit 2.87e-3 → 2.40e-3, luke-f-16 1.64e-3 → 1.40e-3).
 //!
 //! The inputs run side by side, one thread each: much of a run (the blocks, the step limiter,
-//! the QEM) is sequential, so the second core would otherwise idle through it. (This test once
-//! also ran manifoldplus-chair, whose bar was "not above init + QEM"; the CI time it cost is
-//! better spent elsewhere, and the evaluation script covers it.)
+//! the QEM) is sequential, so the second core would otherwise idle through it.
 
 use std::path::PathBuf;
 
