@@ -19,13 +19,13 @@ use crate::blocks::block::{Block, BlockContext, BlockStats};
 use crate::blocks::collapse::apply_collapse;
 use crate::blocks::guard::IntersectionGuard;
 use crate::blocks::qslim::{
-    EdgeCost, QSlimOptions, Quadric, ValidityOptions, edge_cost, edge_cost_lower_bound,
-    vertex_quadrics,
+    EdgeCost, QSlimOptions, ValidityOptions, edge_cost, edge_cost_lower_bound, vertex_quadrics,
 };
 use crate::blocks::select::{SelectOptions, Selection, select_independent_edges};
 use crate::geometry::Geometry;
 use crate::optim::Optimizer;
 use crate::optim::{compact_with_optimizer, sync_optimizer_len};
+use crate::quadric::Quadric;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
