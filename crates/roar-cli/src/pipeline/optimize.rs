@@ -3,8 +3,8 @@
 //! `checkpoint_interval` iterations and the last state, each with its loss, for the finish.
 
 use roar_loss::{KnnOptions, KnnPlanarProjector, Loss, LossError, PointCloud, Shape};
-use roar_mesh::Mesh;
 use roar_mesh::spatial::Projector;
+use roar_mesh::{Mesh, TrackedMesh};
 use roar_ops::blocks::block::{BlockContext, BlockStats};
 use roar_ops::optim::{Optimizer, OptimizerOptions};
 use roar_ops::untangle::{LimiterOptions, limit_steps};
@@ -117,7 +117,9 @@ pub(super) fn optimize(
                 && iteration % scheduled.every == 0
                 && !(scheduled.skip_first && iteration == 0);
             if due {
-                let block_stats = scheduled.block.apply(&mut mesh, &mut optimizer, &context);
+                let block_stats = scheduled
+                    .block
+                    .apply(&mut TrackedMesh::new(&mut mesh, &mut optimizer), &context);
                 *run.stats
                     .block_accepted
                     .entry(block_stats.name)
@@ -210,10 +212,12 @@ pub(super) fn move_vertices(
 
 /// The triangles of a compact mesh (compacting it, and the optimizer with it, if needed).
 fn compact_triangles(mesh: &mut Mesh, optimizer: &mut Optimizer) -> Vec<[u32; 3]> {
-    if mesh.vertex_capacity() != mesh.n_vertices() || mesh.face_capacity() != mesh.n_faces() {
-        roar_ops::optim::compact_with_optimizer(mesh, optimizer);
+    let mut tracked = TrackedMesh::new(mesh, optimizer);
+    if tracked.vertex_capacity() != tracked.n_vertices()
+        || tracked.face_capacity() != tracked.n_faces()
+    {
+        tracked.compact();
     }
-    roar_ops::optim::sync_optimizer_len(mesh, optimizer);
     mesh.faces()
         .map(|f| mesh.face_vertices(f).map(|v| v.raw()))
         .collect()
