@@ -18,15 +18,7 @@ impl Quadric {
     pub fn from_plane(n: DVec3, point: DVec3, weight: f64) -> Quadric {
         let d = -n.dot(point);
         Quadric {
-            a: [
-                n.x * n.x,
-                n.x * n.y,
-                n.x * n.z,
-                n.y * n.y,
-                n.y * n.z,
-                n.z * n.z,
-            ]
-            .map(|x| x * weight),
+            a: outer(n).map(|x| x * weight),
             b: n * (d * weight),
             c: d * d * weight,
         }
@@ -38,15 +30,7 @@ impl Quadric {
     /// costs and the decimation each keep their own rounding, so their outputs do not move.
     pub fn add_plane(&mut self, n: DVec3, point: DVec3, weight: f64) {
         let d = -n.dot(point);
-        let products = [
-            n.x * n.x,
-            n.x * n.y,
-            n.x * n.z,
-            n.y * n.y,
-            n.y * n.z,
-            n.z * n.z,
-        ];
-        for (x, p) in self.a.iter_mut().zip(products) {
+        for (x, p) in self.a.iter_mut().zip(outer(n)) {
             *x += p * weight;
         }
         self.b += n * (weight * d);
@@ -108,6 +92,18 @@ impl Quadric {
         ) / det;
         p.is_finite().then_some(p)
     }
+}
+
+/// The upper triangle of `n nᵀ` (xx, xy, xz, yy, yz, zz), as a [`Quadric`] stores its A.
+fn outer(n: DVec3) -> [f64; 6] {
+    [
+        n.x * n.x,
+        n.x * n.y,
+        n.x * n.z,
+        n.y * n.y,
+        n.y * n.z,
+        n.z * n.z,
+    ]
 }
 
 /// Placement and cost of merging two vertices with quadric sum `q`: the minimiser of `q` if it
