@@ -12,7 +12,7 @@ use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use roar_mesh::shapes::perturbed;
 use roar_mesh::spatial::{Projector, SphereProjector, regular_sample_points};
-use roar_mesh::{DVec3, Mesh};
+use roar_mesh::{DVec3, Mesh, TrackedMesh};
 use roar_ops::blocks::collapse::{FaceCollapseOptions, face_collapse};
 use roar_ops::blocks::smoothing::{SmoothingOptions, tangential_smoothing};
 use roar_ops::blocks::split::{FaceSplitOptions, SplitThreshold, face_split};
@@ -81,8 +81,7 @@ fn blocks(c: &mut Criterion) {
             || (folded.clone(), optimizer(&folded)),
             |(mut m, mut o)| {
                 black_box(face_collapse(
-                    &mut m,
-                    &mut o,
+                    &mut TrackedMesh::new(&mut m, &mut o),
                     &FaceCollapseOptions::default(),
                 ))
             },
@@ -94,8 +93,7 @@ fn blocks(c: &mut Criterion) {
             || (smooth.clone(), optimizer(&smooth)),
             |(mut m, mut o)| {
                 black_box(face_split(
-                    &mut m,
-                    &mut o,
+                    &mut TrackedMesh::new(&mut m, &mut o),
                     &sphere,
                     f + 2000,
                     &split_options,
@@ -107,7 +105,14 @@ fn blocks(c: &mut Criterion) {
     group.bench_function("face_split_at_budget", |b| {
         b.iter_batched(
             || (smooth.clone(), optimizer(&smooth)),
-            |(mut m, mut o)| black_box(face_split(&mut m, &mut o, &sphere, f, &split_options)),
+            |(mut m, mut o)| {
+                black_box(face_split(
+                    &mut TrackedMesh::new(&mut m, &mut o),
+                    &sphere,
+                    f,
+                    &split_options,
+                ))
+            },
             BatchSize::LargeInput,
         )
     });
@@ -177,12 +182,20 @@ fn blocks(c: &mut Criterion) {
     let (mut m, mut o) = (folded.clone(), optimizer(&folded));
     eprintln!(
         "face_collapse: {:?}",
-        face_collapse(&mut m, &mut o, &FaceCollapseOptions::default())
+        face_collapse(
+            &mut TrackedMesh::new(&mut m, &mut o),
+            &FaceCollapseOptions::default()
+        )
     );
     let (mut m, mut o) = (smooth.clone(), optimizer(&smooth));
     eprintln!(
         "face_split under budget: {:?}",
-        face_split(&mut m, &mut o, &sphere, f + 2000, &split_options)
+        face_split(
+            &mut TrackedMesh::new(&mut m, &mut o),
+            &sphere,
+            f + 2000,
+            &split_options
+        )
     );
 }
 

@@ -5,10 +5,9 @@
 //! Diagnostic only: the exact all-pairs check after every block makes the run much slower.
 
 use roar_cli::pipeline::{ReconstructConfig, Reconstruction, ScheduledBlock};
-use roar_mesh::Mesh;
+use roar_mesh::TrackedMesh;
 use roar_mesh::spatial::count_intersecting_faces;
 use roar_ops::blocks::block::{Block, BlockContext, BlockStats};
-use roar_ops::optim::Optimizer;
 use std::cell::RefCell;
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -42,14 +41,9 @@ impl Block for Counted {
         self.inner.name()
     }
 
-    fn apply(
-        &mut self,
-        mesh: &mut Mesh,
-        optimizer: &mut Optimizer,
-        ctx: &BlockContext,
-    ) -> BlockStats {
+    fn apply(&mut self, mesh: &mut TrackedMesh, ctx: &BlockContext) -> BlockStats {
         let before = count_intersecting_faces(mesh);
-        let stats = self.inner.apply(mesh, optimizer, ctx);
+        let stats = self.inner.apply(mesh, ctx);
         let after = count_intersecting_faces(mesh);
         let mut counts = self.tally.borrow_mut();
         let last = counts.last;

@@ -54,18 +54,25 @@ pub fn parse_faces(text: &str) -> Result<usize, String> {
 /// per-pixel parts match the measured peak of a short run (docs/reliability.md, "Memory"); the
 /// per-face part is a deliberately high guess. It is meant to tell a budget that fits from one
 /// that cannot, not to predict a figure.
-pub fn estimated_peak_bytes(
-    config: &crate::pipeline::ReconstructConfig,
-    input_faces: usize,
-) -> u64 {
-    let working = config.working_budget() as u64;
-    let pixels = (config.views_per_axis * config.views_per_axis) as u64
-        * u64::from(config.render_resolution).pow(2);
+pub fn estimated_peak_bytes(sizes: &RunSizes) -> u64 {
     FIXED_BYTES
-        + BYTES_PER_WORKING_FACE * working
-        + BYTES_PER_INPUT_FACE * input_faces as u64
-        + BYTES_PER_PIXEL * pixels
-        + BYTES_PER_SAMPLE * config.point_cloud_samples as u64
+        + BYTES_PER_WORKING_FACE * sizes.working_faces as u64
+        + BYTES_PER_INPUT_FACE * sizes.input_faces as u64
+        + BYTES_PER_PIXEL * sizes.render_pixels
+        + BYTES_PER_SAMPLE * sizes.cloud_samples as u64
+}
+
+/// The sizes [`estimated_peak_bytes`] reads (the caller takes them from its config and input).
+#[derive(Debug, Clone, Copy)]
+pub struct RunSizes {
+    /// The working budget W.
+    pub working_faces: usize,
+    /// Faces of the input.
+    pub input_faces: usize,
+    /// Pixels of all target renders together.
+    pub render_pixels: u64,
+    /// Point cloud samples.
+    pub cloud_samples: usize,
 }
 
 /// Memory the kernel says is available (`MemAvailable` in `/proc/meminfo`), if it says.

@@ -4,11 +4,10 @@
 use roar_cli::pipeline::{
     InitKind, PipelineError, ReconstructConfig, Reconstruction, RunStats, ScheduledBlock,
 };
-use roar_mesh::Mesh;
 use roar_mesh::shapes::torus;
 use roar_mesh::spatial::self_intersecting_faces;
+use roar_mesh::{Mesh, TrackedMesh};
 use roar_ops::blocks::block::{Block, BlockContext, BlockStats};
-use roar_ops::optim::Optimizer;
 
 mod common;
 
@@ -75,7 +74,7 @@ impl Block for Scramble {
         "scramble"
     }
 
-    fn apply(&mut self, mesh: &mut Mesh, _: &mut Optimizer, ctx: &BlockContext) -> BlockStats {
+    fn apply(&mut self, mesh: &mut TrackedMesh, ctx: &BlockContext) -> BlockStats {
         let mut stats = BlockStats::new(self.name());
         if ctx.iteration == self.at_iteration {
             let mut state = 0x9E37_79B9_7F4A_7C15u64;
@@ -85,9 +84,11 @@ impl Block for Scramble {
                 state ^= state << 17;
                 (state >> 11) as f64 / (1u64 << 53) as f64 - 0.5
             };
-            for p in mesh.positions_mut() {
-                *p = glam::DVec3::new(next(), next(), next());
-            }
+            mesh.with_fixed_vertices(|mesh| {
+                for p in mesh.positions_mut() {
+                    *p = glam::DVec3::new(next(), next(), next());
+                }
+            });
             stats.accepted = mesh.n_vertices();
         }
         stats

@@ -35,6 +35,7 @@ mod ops;
 pub mod shapes;
 pub mod spatial;
 mod topology;
+mod tracked;
 mod validate;
 
 pub use circulators::{FacesAround, Neighbors, Outgoing};
@@ -44,3 +45,4 @@ pub use glam::DVec3;
 pub use handles::{EdgeId, FaceId, HalfedgeId, VertexId};
 pub use mesh::{DEGENERATE_CROSS, DEGENERATE_NORMAL, Mesh};
 pub use ops::{Collapse, EdgeSplit, FaceSplit};
+pub use tracked::{NoStore, TrackedMesh, VertexStore};

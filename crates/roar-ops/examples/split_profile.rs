@@ -20,7 +20,7 @@ use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use roar_mesh::shapes::{genus_n_solid, icosphere, perturbed};
 use roar_mesh::spatial::{Projector, SphereProjector, regular_samples};
-use roar_mesh::{DVec3, Mesh};
+use roar_mesh::{DVec3, Mesh, TrackedMesh};
 use roar_ops::blocks::qslim::{QSlimOptions, VertexPlane};
 use roar_ops::blocks::split::{FaceSplitOptions, SplitThreshold, face_scores, face_split};
 use roar_ops::geometry::Geometry;
@@ -151,7 +151,12 @@ fn digests(calls: u64) {
         let mut line = String::new();
         for seed in 0..calls {
             let options = FaceSplitOptions { seed, ..options };
-            let stats = face_split(&mut m, &mut o, projector, budget, &options);
+            let stats = face_split(
+                &mut TrackedMesh::new(&mut m, &mut o),
+                projector,
+                budget,
+                &options,
+            );
             line += &format!(
                 " [{} faces, {} splits, {} paired, {} free]",
                 m.n_faces(),
@@ -197,7 +202,12 @@ fn main() {
             let mut o = Optimizer::new(m.vertex_capacity(), OptimizerOptions::default())
                 .expect("optimizer");
             let t = Instant::now();
-            let stats = face_split(&mut m, &mut o, &sphere, f + 2000, &options);
+            let stats = face_split(
+                &mut TrackedMesh::new(&mut m, &mut o),
+                &sphere,
+                f + 2000,
+                &options,
+            );
             println!(
                 "face_split {:.1} ms, accepted {}, exact edge costs {}",
                 ms(t),
@@ -236,7 +246,12 @@ fn main() {
         let mut o =
             Optimizer::new(m.vertex_capacity(), OptimizerOptions::default()).expect("optimizer");
         let t = Instant::now();
-        let stats = face_split(&mut m, &mut o, &sphere, f + 2000, &options);
+        let stats = face_split(
+            &mut TrackedMesh::new(&mut m, &mut o),
+            &sphere,
+            f + 2000,
+            &options,
+        );
         let t_block = ms(t);
         println!(
             "samples {} ({:.1} ms) geometry {t_geom:.1} ms, project {t_project:.1} ms, \

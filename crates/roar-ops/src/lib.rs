@@ -12,7 +12,8 @@
 //! | loop and finish | [`untangle`] | the step limiter and the untangle block |
 //! | finish | [`finish`] | fill to the budget, outward offset, handle removal when the budget needs it, data flips, sliver flips, degenerate collapses |
 //!
-//! Shared by several stages: [`geometry`] (per-mesh normals, quality measures) and a private
+//! Shared by several stages: [`geometry`] (per-mesh normals, quality measures), [`quadric`] (the
+//! error quadrics of the decimation and of the QSlim edge costs) and a private
 //! exact face–face intersection test. Dependencies run down this table's stages and into the
 //! shared modules; no two modules import each other.
 
@@ -30,3 +31,4 @@ pub mod finish;
 
 pub mod geometry;
 mod intersect;
+pub mod quadric;

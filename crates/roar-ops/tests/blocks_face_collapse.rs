@@ -4,8 +4,8 @@
 mod blocks_common;
 
 use blocks_common::{assert_contract, key, plant_fold, rows_by_position, tagged_optimizer};
-use roar_mesh::VertexId;
 use roar_mesh::shapes::icosphere;
+use roar_mesh::{TrackedMesh, VertexId};
 use roar_ops::blocks::collapse::{FaceCollapseOptions, face_collapse, flagged_faces};
 use roar_ops::geometry::Geometry;
 
@@ -30,7 +30,10 @@ fn removes_a_planted_fold() {
     let mut opt = tagged_optimizer(&mesh);
     let mut rounds = 0;
     while flagged_count(&mesh) > 0 && rounds < 5 {
-        let stats = face_collapse(&mut mesh, &mut opt, &FaceCollapseOptions::default());
+        let stats = face_collapse(
+            &mut TrackedMesh::new(&mut mesh, &mut opt),
+            &FaceCollapseOptions::default(),
+        );
         assert!(
             stats.accepted > 0,
             "a flagged mesh must collapse something: {stats:?}"
@@ -47,7 +50,10 @@ fn clean_sphere_is_left_alone() {
     let mut mesh = icosphere(3);
     let before = mesh.clone();
     let mut opt = tagged_optimizer(&mesh);
-    let stats = face_collapse(&mut mesh, &mut opt, &FaceCollapseOptions::default());
+    let stats = face_collapse(
+        &mut TrackedMesh::new(&mut mesh, &mut opt),
+        &FaceCollapseOptions::default(),
+    );
     assert_eq!(stats.candidates, 0);
     assert_eq!(stats.accepted, 0);
     assert_eq!(stats.sub[0].accepted, 0, "an icosphere has nothing to flip");
@@ -65,7 +71,7 @@ fn survivors_keep_the_chosen_endpoints_position_and_row() {
         flips: None,
         ..FaceCollapseOptions::default()
     };
-    let stats = face_collapse(&mut mesh, &mut opt, &options);
+    let stats = face_collapse(&mut TrackedMesh::new(&mut mesh, &mut opt), &options);
     assert!(stats.accepted > 0, "jitter 0.1 folds some faces: {stats:?}");
     assert_eq!(mesh.n_vertices(), n_before - stats.accepted);
     assert_contract(&mesh, &opt, euler, "face_collapse");
@@ -130,7 +136,7 @@ fn normal_size_gate_spares_thin_parts_but_still_removes_folds() {
         "the planted fold is flagged"
     );
     let mut opt = tagged_optimizer(&mesh);
-    let stats = face_collapse(&mut mesh, &mut opt, &gated);
+    let stats = face_collapse(&mut TrackedMesh::new(&mut mesh, &mut opt), &gated);
     assert!(stats.accepted > 0, "{stats:?}");
     assert_contract(&mesh, &opt, euler, "gated face_collapse");
     assert_eq!(flagged_with(&mesh, &gated), 0, "fold left");

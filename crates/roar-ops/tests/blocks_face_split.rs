@@ -5,9 +5,9 @@ mod blocks_common;
 
 use blocks_common::{assert_contract, tagged_optimizer};
 use rand::SeedableRng;
-use roar_mesh::DVec3;
 use roar_mesh::shapes::{genus_n_solid, icosphere};
 use roar_mesh::spatial::{Projector, RegularSamples, SphereProjector, regular_samples};
+use roar_mesh::{DVec3, TrackedMesh};
 use roar_ops::blocks::qslim::{QSlimOptions, VertexPlane};
 use roar_ops::blocks::split::{FaceSplitOptions, SplitThreshold, face_scores, face_split};
 use roar_ops::geometry::Geometry;
@@ -171,7 +171,12 @@ fn splits_under_budget() {
     let euler = mesh.euler_characteristic();
     let mut opt = tagged_optimizer(&mesh);
     let f0 = mesh.n_faces();
-    let stats = face_split(&mut mesh, &mut opt, &UNIT_SPHERE, f0 + 100, &per_face());
+    let stats = face_split(
+        &mut TrackedMesh::new(&mut mesh, &mut opt),
+        &UNIT_SPHERE,
+        f0 + 100,
+        &per_face(),
+    );
     assert_contract(&mesh, &opt, euler, "face_split");
     assert_eq!(stats.accepted, 50, "Δ = 50 splits: {stats:?}");
     assert_eq!(mesh.n_faces(), f0 + 100);
@@ -197,7 +202,12 @@ fn face_count_is_constant_at_budget() {
             seed: it,
             ..per_face()
         };
-        face_split(&mut mesh, &mut opt, &UNIT_SPHERE, f0, &options);
+        face_split(
+            &mut TrackedMesh::new(&mut mesh, &mut opt),
+            &UNIT_SPHERE,
+            f0,
+            &options,
+        );
         assert_contract(&mesh, &opt, euler, "face_split");
         assert!(
             mesh.n_faces().abs_diff(f0) <= 2,
@@ -222,7 +232,12 @@ fn face_count_decreases_over_budget() {
         },
         ..per_face()
     };
-    let stats = face_split(&mut mesh, &mut opt, &UNIT_SPHERE, f0 - 40, &options);
+    let stats = face_split(
+        &mut TrackedMesh::new(&mut mesh, &mut opt),
+        &UNIT_SPHERE,
+        f0 - 40,
+        &options,
+    );
     assert_contract(&mesh, &opt, euler, "face_split");
     assert!(mesh.n_faces() < f0, "{stats:?}");
 }
@@ -339,7 +354,12 @@ fn run_calls(
     let stats = (0..calls)
         .map(|seed| {
             let options = FaceSplitOptions { seed, ..*options };
-            face_split(&mut m, &mut opt, projector, budget, &options)
+            face_split(
+                &mut TrackedMesh::new(&mut m, &mut opt),
+                projector,
+                budget,
+                &options,
+            )
         })
         .collect();
     (m, opt, stats)

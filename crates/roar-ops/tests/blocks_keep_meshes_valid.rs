@@ -5,8 +5,8 @@ mod blocks_common;
 
 use blocks_common::{assert_contract, random_mesh, tagged_optimizer};
 use proptest::prelude::*;
-use roar_mesh::Mesh;
 use roar_mesh::spatial::{SphereProjector, count_intersecting_faces};
+use roar_mesh::{Mesh, TrackedMesh};
 use roar_ops::blocks::block::{Block, BlockContext};
 use roar_ops::blocks::collapse::{FaceCollapse, FaceCollapseOptions};
 use roar_ops::blocks::flips::{EdgeFlips, FlipOptions};
@@ -100,7 +100,7 @@ fn max_crossings(
             face_budget: budget,
             projector: Some(&sphere),
         };
-        blocks[i].apply(mesh, &mut opt, &ctx);
+        blocks[i].apply(&mut TrackedMesh::new(mesh, &mut opt), &ctx);
         assert_contract(mesh, &opt, euler, blocks[i].name());
         worst = worst.max(count_intersecting_faces(mesh));
     }
@@ -160,7 +160,7 @@ proptest! {
             let budget = (mesh.n_faces() as i64 + budget_offset).max(8) as usize;
             let ctx = BlockContext { iteration: it, face_budget: budget, projector: Some(&sphere) };
             let block = &mut all[i];
-            let stats = block.apply(&mut mesh, &mut opt, &ctx);
+            let stats = block.apply(&mut TrackedMesh::new(&mut mesh, &mut opt), &ctx);
             prop_assert_eq!(stats.name, block.name());
             assert_contract(&mesh, &opt, euler, block.name());
         }
@@ -177,7 +177,7 @@ fn face_split_without_projector_does_nothing() {
         face_budget: 10_000,
         projector: None,
     };
-    let stats = FaceSplit::default().apply(&mut mesh, &mut opt, &ctx);
+    let stats = FaceSplit::default().apply(&mut TrackedMesh::new(&mut mesh, &mut opt), &ctx);
     assert_eq!(stats.rejected.get("no_projector"), Some(&1));
     assert_eq!(mesh, before);
 }

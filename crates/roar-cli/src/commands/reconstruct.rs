@@ -323,7 +323,13 @@ fn check_resources(
     input_faces: usize,
     force: bool,
 ) -> anyhow::Result<()> {
-    let needed = crate::budget::estimated_peak_bytes(config, input_faces);
+    let needed = crate::budget::estimated_peak_bytes(&crate::budget::RunSizes {
+        working_faces: config.working_budget(),
+        input_faces,
+        render_pixels: (config.views_per_axis * config.views_per_axis) as u64
+            * u64::from(config.render_resolution).pow(2),
+        cloud_samples: config.point_cloud_samples,
+    });
     let Some(available) = crate::budget::available_memory_bytes() else {
         return Ok(());
     };

@@ -1,16 +1,18 @@
 //! The [`Block`] trait: one remeshing step the pipeline can run, reorder or replace.
 //!
 //! Contract of every block (and of the free function it wraps):
-//! - on entry the mesh is a valid closed 2-manifold and the optimizer has a row per vertex slot
-//!   (blocks call [`Optimizer::grow`] to the vertex capacity first, so fresh vertices are fine);
+//! - on entry the mesh is a valid closed 2-manifold; the block gets the per-vertex store that
+//!   must follow it (the loop's optimizer, any [`VertexStore`]) and edits the mesh only through
+//!   a [`TrackedMesh`] over the two, so every operator and compaction notifies the store and no
+//!   block can forget a transfer;
 //! - on exit the mesh is still a valid closed 2-manifold (genus and components unchanged);
-//! - a block that changed the vertex set **compacts the mesh itself** and forwards the remap to
-//!   [`Optimizer::apply_remap`] ([`crate::optim::compact_with_optimizer`]), so after any block the mesh has no
-//!   tombstones and `optimizer.len() == mesh.vertex_capacity()`;
+//! - a block that changed the vertex set **compacts the mesh itself** ([`TrackedMesh::compact`]),
+//!   so after any block the mesh has no tombstones and the store has a row per vertex;
 //! - geometric vetoes are counted by reason in [`BlockStats::rejected`].
 
-use crate::optim::Optimizer;
-use roar_mesh::Mesh;
+use roar_mesh::TrackedMesh;
+#[cfg(doc)]
+use roar_mesh::VertexStore;
 use roar_mesh::spatial::Projector;
 use serde::Serialize;
 use std::collections::BTreeMap;
@@ -43,12 +45,7 @@ pub trait Block {
     /// Stable name (used in stats, logs and configs).
     fn name(&self) -> &'static str;
     /// Runs the block once. See the module docs for the contract.
-    fn apply(
-        &mut self,
-        mesh: &mut Mesh,
-        optimizer: &mut Optimizer,
-        ctx: &BlockContext,
-    ) -> BlockStats;
+    fn apply(&mut self, mesh: &mut TrackedMesh, ctx: &BlockContext) -> BlockStats;
 }
 
 /// What a block did.

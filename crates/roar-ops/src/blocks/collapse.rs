@@ -18,9 +18,7 @@ use crate::blocks::guard::IntersectionGuard;
 use crate::blocks::qslim::{EdgeCost, QSlimOptions, ValidityOptions, edge_cost, vertex_quadrics};
 use crate::blocks::select::{SelectOptions, select_independent_edges};
 use crate::geometry::Geometry;
-use crate::optim::Optimizer;
-use crate::optim::{compact_with_optimizer, sync_optimizer_len};
-use roar_mesh::Mesh;
+use roar_mesh::{Mesh, TrackedMesh};
 
 /// Options of [`face_collapse`] (spec §3.6, note 4).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -109,13 +107,8 @@ pub fn folds_onto_a_neighbour(mesh: &Mesh, geometry: &Geometry, f: roar_mesh::Fa
 /// the link condition), `"not_selected"` (valid but lost the independent selection),
 /// `"intersection"` (vetoed by the guard, if on);
 /// `counters["flagged_faces"]`; `sub` = the flip stats.
-pub fn face_collapse(
-    mesh: &mut Mesh,
-    optimizer: &mut Optimizer,
-    options: &FaceCollapseOptions,
-) -> BlockStats {
+pub fn face_collapse(mesh: &mut TrackedMesh, options: &FaceCollapseOptions) -> BlockStats {
     let mut stats = BlockStats::new("face_collapse");
-    sync_optimizer_len(mesh, optimizer);
     let geometry = Geometry::compute(mesh);
     let flags = flagged_faces(mesh, &geometry, options);
     stats.count("flagged_faces", flags.iter().filter(|&&f| f).count());
@@ -154,7 +147,7 @@ pub fn face_collapse(
     for &e in &selection.edges {
         let c =
             placement[e.index()].expect("selected edges have positive priority, so a placement");
-        if apply_collapse(mesh, optimizer, &c, guard.as_mut(), &mut stats) {
+        if apply_collapse(mesh, &c, guard.as_mut(), &mut stats) {
             stats.accepted += 1;
         }
     }
@@ -163,10 +156,12 @@ pub fn face_collapse(
         valid.saturating_sub(selection.edges.len() + selection.link_rejected),
     );
     if stats.accepted > 0 {
-        compact_with_optimizer(mesh, optimizer);
+        mesh.compact();
     }
     if let Some(flip_options) = &options.flips {
-        stats.sub.push(flip_edges(mesh, flip_options));
+        stats
+            .sub
+            .push(mesh.with_fixed_vertices(|mesh| flip_edges(mesh, flip_options)));
     }
     stats
 }
@@ -183,24 +178,19 @@ impl Block for FaceCollapse {
         "face_collapse"
     }
 
-    fn apply(
-        &mut self,
-        mesh: &mut Mesh,
-        optimizer: &mut Optimizer,
-        _ctx: &BlockContext,
-    ) -> BlockStats {
-        face_collapse(mesh, optimizer, &self.options)
+    fn apply(&mut self, mesh: &mut TrackedMesh, _ctx: &BlockContext) -> BlockStats {
+        face_collapse(mesh, &self.options)
     }
 }
 
 /// Applies the collapse `c` chosen by a block: the mesh merges `c.halfedge`'s tail into `c.keep`
-/// (which keeps its position), and the optimizer row of `c.keep` survives. With a `guard`, a
+/// (which keeps its position), and the tracked store hears of it (the optimizer row of `c.keep`
+/// survives). With a `guard`, a
 /// collapse that would make a face intersect another one is skipped and counted as
 /// `rejected["intersection"]`; a collapse the link condition refuses (an earlier collapse of the
 /// block changed the neighbourhood) as `rejected["link"]`. Returns whether it was applied.
 pub fn apply_collapse(
-    mesh: &mut Mesh,
-    optimizer: &mut Optimizer,
+    mesh: &mut TrackedMesh,
     c: &EdgeCost,
     mut guard: Option<&mut IntersectionGuard>,
     stats: &mut BlockStats,
@@ -211,7 +201,7 @@ pub fn apply_collapse(
     }
     if let Some(guard) = guard.as_deref_mut() {
         let p = mesh.position(c.keep);
-        if guard.collapse_intersects(mesh, c.halfedge, p) {
+        if mesh.with_fixed_vertices(|mesh| guard.collapse_intersects(mesh, c.halfedge, p)) {
             stats.reject("intersection", 1);
             return false;
         }
@@ -219,9 +209,7 @@ pub fn apply_collapse(
     let out = mesh
         .collapse(c.halfedge)
         .expect("can_collapse passed just before (invariant)");
-    optimizer
-        .on_collapse(out.survivor.raw(), c.keep.raw())
-        .expect("optimizer rows cover every vertex slot (invariant)");
+    debug_assert_eq!(out.survivor, c.keep, "the kept endpoint is the head");
     if let Some(guard) = guard {
         for f in out.removed_faces {
             guard.mark(f);

@@ -18,8 +18,7 @@
 use crate::blocks::block::{Block, BlockContext, BlockStats};
 use crate::blocks::guard::IntersectionGuard;
 use crate::geometry::triangle_normal;
-use crate::optim::Optimizer;
-use roar_mesh::{EdgeId, Mesh};
+use roar_mesh::{EdgeId, Mesh, TrackedMesh};
 
 /// Options of [`flip_edges`] (spec §3.7).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -174,12 +173,7 @@ impl Block for EdgeFlips {
         "edge_flips"
     }
 
-    fn apply(
-        &mut self,
-        mesh: &mut Mesh,
-        _optimizer: &mut Optimizer,
-        _ctx: &BlockContext,
-    ) -> BlockStats {
-        flip_edges(mesh, &self.options)
+    fn apply(&mut self, mesh: &mut TrackedMesh, _ctx: &BlockContext) -> BlockStats {
+        mesh.with_fixed_vertices(|mesh| flip_edges(mesh, &self.options))
     }
 }

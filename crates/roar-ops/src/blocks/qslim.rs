@@ -8,7 +8,7 @@
 //! clamped at 0; placements are the two endpoints only (half-edge collapse).
 
 use crate::geometry::{Geometry, triangle_quality};
-use glam::DMat3;
+use crate::quadric::Quadric;
 use roar_mesh::{DEGENERATE_CROSS, DVec3, EdgeId, HalfedgeId, Mesh, VertexId};
 
 /// How the vertex plane's "generalized normal" blends the vertex normal with the Laplacian
@@ -48,51 +48,6 @@ impl Default for QSlimOptions {
             edge_weight: 1.0,
             vertex_weight: 100.0,
             vertex_plane: VertexPlane::RawMagnitude,
-        }
-    }
-}
-
-/// A quadric `E(p) = pᵀ A p + 2 b·p + c`.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Quadric {
-    /// Symmetric 3×3 part.
-    pub a: DMat3,
-    /// Linear part.
-    pub b: DVec3,
-    /// Constant part.
-    pub c: f64,
-}
-
-impl Default for Quadric {
-    fn default() -> Self {
-        Self {
-            a: DMat3::ZERO,
-            b: DVec3::ZERO,
-            c: 0.0,
-        }
-    }
-}
-
-impl Quadric {
-    /// Adds the plane through `x0` with unit normal `n`, weighted by `w`.
-    pub fn add_plane(&mut self, n: DVec3, x0: DVec3, w: f64) {
-        let d = -n.dot(x0);
-        self.a += DMat3::from_cols(n * n.x, n * n.y, n * n.z) * w;
-        self.b += n * (w * d);
-        self.c += w * d * d;
-    }
-
-    /// `pᵀ A p + 2 b·p + c` (not clamped).
-    pub fn eval(&self, p: DVec3) -> f64 {
-        p.dot(self.a * p) + 2.0 * self.b.dot(p) + self.c
-    }
-
-    /// Sum of two quadrics.
-    pub fn sum(&self, other: &Quadric) -> Quadric {
-        Quadric {
-            a: self.a + other.a,
-            b: self.b + other.b,
-            c: self.c + other.c,
         }
     }
 }
@@ -243,7 +198,7 @@ pub fn edge_cost(
 ) -> Result<EdgeCost, Invalid> {
     let h = e.halfedge();
     let (a, b) = (mesh.tail(h), mesh.head(h));
-    let q = quadrics[a.index()].sum(&quadrics[b.index()]);
+    let q = quadrics[a.index()].add(&quadrics[b.index()]);
     let skip = mesh.edge_length(e) < options.skip_checks_below_length;
     let mut best: Option<EdgeCost> = None;
     let mut failure = None;
@@ -256,7 +211,7 @@ pub fn edge_cost(
             });
             continue;
         }
-        let cost = q.eval(mesh.position(keep)).max(0.0);
+        let cost = q.eval(mesh.position(keep));
         if best.is_none_or(|bc| cost < bc.cost) {
             best = Some(EdgeCost {
                 cost,
@@ -276,9 +231,9 @@ pub fn edge_cost(
 pub fn edge_cost_lower_bound(mesh: &Mesh, quadrics: &[Quadric], e: EdgeId) -> f64 {
     let h = e.halfedge();
     let (a, b) = (mesh.tail(h), mesh.head(h));
-    let q = quadrics[a.index()].sum(&quadrics[b.index()]);
-    let keep_b = q.eval(mesh.position(b)).max(0.0);
-    let keep_a = q.eval(mesh.position(a)).max(0.0);
+    let q = quadrics[a.index()].add(&quadrics[b.index()]);
+    let keep_b = q.eval(mesh.position(b));
+    let keep_a = q.eval(mesh.position(a));
     keep_b.min(keep_a)
 }
 

@@ -18,10 +18,9 @@
 
 use crate::blocks::block::{Block, BlockContext, BlockStats};
 use crate::geometry::Geometry;
-use crate::optim::Optimizer;
 use crate::untangle::{LimiterOptions, limit_steps};
 use roar_mesh::spatial::closest_point_on_triangle;
-use roar_mesh::{DVec3, Mesh};
+use roar_mesh::{DVec3, Mesh, TrackedMesh};
 
 /// Options of [`tangential_smoothing`] (spec §3.9).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -120,13 +119,8 @@ impl Block for TangentialSmoothing {
         "tangential_smoothing"
     }
 
-    fn apply(
-        &mut self,
-        mesh: &mut Mesh,
-        _optimizer: &mut Optimizer,
-        _ctx: &BlockContext,
-    ) -> BlockStats {
-        tangential_smoothing(mesh, &self.options)
+    fn apply(&mut self, mesh: &mut TrackedMesh, _ctx: &BlockContext) -> BlockStats {
+        mesh.with_fixed_vertices(|mesh| tangential_smoothing(mesh, &self.options))
     }
 }
 

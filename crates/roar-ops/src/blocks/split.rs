@@ -13,19 +13,17 @@
 //!    suppression of faces next to edges with `C_e < 1e-3`, independent set with priorities
 //!    `exp(−C_e)`, `c_e = max(C_e, P_e)`.
 //! 4. Pairing and budget (§3.8 steps 6–7, note 8), then collapses, then 1→3 centroid splits
-//!    (the new vertex gets the mean optimizer row), then compaction.
+//!    (the tracked store hears of each: the new vertex gets the mean optimizer row), then compaction.
 
 use crate::blocks::block::{Block, BlockContext, BlockStats};
 use crate::blocks::collapse::apply_collapse;
 use crate::blocks::guard::IntersectionGuard;
 use crate::blocks::qslim::{
-    EdgeCost, QSlimOptions, Quadric, ValidityOptions, edge_cost, edge_cost_lower_bound,
-    vertex_quadrics,
+    EdgeCost, QSlimOptions, ValidityOptions, edge_cost, edge_cost_lower_bound, vertex_quadrics,
 };
 use crate::blocks::select::{SelectOptions, Selection, select_independent_edges};
 use crate::geometry::Geometry;
-use crate::optim::Optimizer;
-use crate::optim::{compact_with_optimizer, sync_optimizer_len};
+use crate::quadric::Quadric;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
@@ -33,7 +31,7 @@ use roar_mesh::spatial::{
     Projector, RegularSamples, RegularSamplingOptions, SamplePoints, face_grid, grid_point_count,
     regular_sample_points_into,
 };
-use roar_mesh::{DEGENERATE_CROSS, DVec3, EdgeId, FaceId, Mesh};
+use roar_mesh::{DEGENERATE_CROSS, DVec3, EdgeId, FaceId, Mesh, TrackedMesh};
 use std::cell::RefCell;
 
 /// Where the 0.02 curvature threshold of the face score applies (Verification note 1).
@@ -258,7 +256,7 @@ thread_local! {
 }
 
 /// Runs the Face Split block (spec §3.8) with face budget `face_budget` and target projector
-/// `projector`; compacts the mesh and optimizer rows if the topology changed. Keeps its sample
+/// `projector`; compacts the mesh (and so the tracked store's rows) if the topology changed. Keeps its sample
 /// buffers per thread between calls (see `SAMPLE_BUFFERS`).
 ///
 /// Stats: `candidates` = faces with a positive score after suppression; `accepted` = face
@@ -268,8 +266,7 @@ thread_local! {
 /// QSlim cost was computed; see [`FaceSplitOptions::prune_edge_costs`] for what
 /// `independent_edges`, `link` and `swaps` count when it is on).
 pub fn face_split(
-    mesh: &mut Mesh,
-    optimizer: &mut Optimizer,
+    mesh: &mut TrackedMesh,
     projector: &dyn Projector,
     face_budget: usize,
     options: &FaceSplitOptions,
@@ -279,9 +276,8 @@ pub fn face_split(
         || mesh.face_capacity() != mesh.n_faces()
         || mesh.edge_capacity() != mesh.n_edges()
     {
-        compact_with_optimizer(mesh, optimizer);
+        mesh.compact();
     }
-    sync_optimizer_len(mesh, optimizer);
     let n_faces = mesh.n_faces();
     stats.count("faces_before", n_faces);
 
@@ -416,7 +412,7 @@ pub fn face_split(
         let c = costs
             .placement(e)
             .expect("selected edges have finite cost, so a placement");
-        if apply_collapse(mesh, optimizer, &c, guard.as_mut(), &mut stats) {
+        if apply_collapse(mesh, &c, guard.as_mut(), &mut stats) {
             collapsed += 1;
         } else if i < n_paired {
             paired_missing += 1;
@@ -430,16 +426,12 @@ pub fn face_split(
             stats.reject("removed_face", 1);
             continue;
         }
-        let s = mesh.split_face(f, [1.0 / 3.0; 3]);
-        sync_optimizer_len(mesh, optimizer);
-        optimizer
-            .on_face_split(s.new_vertex.raw(), s.parents.map(|v| v.raw()))
-            .expect("optimizer rows cover every vertex slot (invariant)");
+        mesh.split_face(f, [1.0 / 3.0; 3]);
         stats.accepted += 1;
     }
     stats.reject("budget", ranked.len() - n_split);
     if collapsed > 0 || stats.accepted > 0 {
-        compact_with_optimizer(mesh, optimizer);
+        mesh.compact();
     }
     stats.count("faces_after", mesh.n_faces());
     stats
@@ -615,12 +607,7 @@ impl Block for FaceSplit {
         "face_split"
     }
 
-    fn apply(
-        &mut self,
-        mesh: &mut Mesh,
-        optimizer: &mut Optimizer,
-        ctx: &BlockContext,
-    ) -> BlockStats {
+    fn apply(&mut self, mesh: &mut TrackedMesh, ctx: &BlockContext) -> BlockStats {
         let Some(projector) = ctx.projector else {
             let mut stats = BlockStats::new("face_split");
             stats.reject("no_projector", 1);
@@ -633,7 +620,7 @@ impl Block for FaceSplit {
                 .wrapping_add((ctx.iteration as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15)),
             ..self.options
         };
-        face_split(mesh, optimizer, projector, ctx.face_budget, &options)
+        face_split(mesh, projector, ctx.face_budget, &options)
     }
 }
 

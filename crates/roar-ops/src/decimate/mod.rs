@@ -36,15 +36,14 @@
 
 mod grid;
 mod heap;
-mod quadric;
 mod split;
 
 use crate::geometry::is_degenerate;
 use crate::intersect::{PreparedFace, certainly_apart, faces_intersect_filtered, fan_is_embedded};
+use crate::quadric::{Quadric, placement};
 use glam::DVec3;
 use grid::{Box32, FaceGrid};
 use heap::EdgeHeap;
-use quadric::{Quadric, placement};
 use roar_mesh::spatial::Aabb;
 use roar_mesh::{Collapse, EdgeId, FaceId, HalfedgeId, Mesh, Remap, VertexId};
 use std::fmt;

@@ -4,9 +4,11 @@
 //! The optimizer works on plain buffers: positions `&mut [DVec3]`, per-vertex gradients
 //! `&[DVec3]` and the triangles `&[[u32; 3]]` of the current mesh. Vertex ids are indices into
 //! these arrays. It keeps one [`VertexState`] row per vertex id; the topology operators of the
-//! remeshing blocks change the vertex set, so the pipeline must keep the rows in step with the
-//! mesh through the transfer methods ([`Optimizer::on_collapse`], [`Optimizer::on_edge_split`],
-//! [`Optimizer::on_face_split`], [`Optimizer::grow`], [`Optimizer::apply_remap`]; spec §3.12).
+//! remeshing blocks change the vertex set, and the rows follow: the optimizer is a
+//! [`roar_mesh::VertexStore`], so every operator and compaction made through a
+//! [`roar_mesh::TrackedMesh`] over it calls the matching transfer method
+//! ([`Optimizer::on_collapse`], [`Optimizer::on_edge_split`], [`Optimizer::on_face_split`],
+//! [`Optimizer::grow`], [`Optimizer::apply_remap`]; spec §3.12).
 //!
 //! One step, for every live vertex v (a vertex referenced by at least one triangle), with the
 //! global step counter t = 1, 2, … that remeshing never resets:
@@ -42,8 +44,6 @@
 
 mod adjacency;
 mod transfer;
-
-pub use transfer::{compact_with_optimizer, sync_optimizer_len};
 
 use adjacency::VertexAdjacency;
 use glam::DVec3;
@@ -289,9 +289,10 @@ pub struct StepStats {
 /// The per-vertex optimizer of spec §3.2.4, with its state rows and a global step counter.
 ///
 /// Contract with the pipeline: row `i` belongs to vertex id `i` of the arrays passed to
-/// [`Optimizer::step`]. Whenever the mesh's vertex set changes, call the matching transfer
-/// method so the rows follow (see the `transfer` methods' docs). Positions are never touched
-/// by the transfer methods: the mesh operators own them.
+/// [`Optimizer::step`]. Whenever the mesh's vertex set changes, the matching transfer method
+/// must run so the rows follow: editing the mesh through a [`roar_mesh::TrackedMesh`] over the
+/// optimizer does that (see the `transfer` module). Positions are never touched by the
+/// transfer methods: the mesh operators own them.
 #[derive(Debug, Clone)]
 pub struct Optimizer {
     options: OptimizerOptions,

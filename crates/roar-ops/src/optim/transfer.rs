@@ -1,51 +1,68 @@
 //! Keeping the optimizer rows in step with the mesh through topology changes (spec §3.12).
 //!
-//! The contract: the mesh operators move positions and return outcome records (which vertex
-//! survived, which vertex is new and from which parents); the pipeline forwards them here with
-//! plain `u32` vertex ids. The rows never hold positions, so these methods only touch m1, m2
-//! and ν. Flips change no vertex, so they need no call. The step counter is never touched:
-//! t is global and remeshing does not reset it (§3.2.4).
+//! The optimizer is a [`VertexStore`]: edit the mesh through a [`TrackedMesh`] over it and
+//! every operator and compaction forwards its outcome record here, so no caller can forget a
+//! transfer. The rows never hold positions, so these methods only touch m1, m2 and ν. Flips
+//! change no vertex, so they need no call. The step counter is never touched: t is global and
+//! remeshing does not reset it (§3.2.4).
 //!
-//! | mesh event | call |
-//! |---|---|
-//! | edge collapse a→b, position taken from endpoint `s` | `on_collapse(b, s)` |
-//! | edge split of (a, b) at parameter t, new vertex m | `on_edge_split(m, [a, b], t)` |
-//! | face split 1→3 of (a, b, c), new vertex m | `on_face_split(m, [a, b, c])` |
-//! | vertices appended by other means | `grow(n)` |
-//! | compaction (garbage collection) of the vertex arrays | `apply_remap(old_to_new)` |
+//! | mesh event | store call | transfer |
+//! |---|---|---|
+//! | edge collapse a→b (b keeps its position) | `on_collapse` | b keeps its row |
+//! | edge split of (a, b) at parameter t, new vertex m | `on_edge_split` | `on_edge_split(m, [a, b], t)` |
+//! | face split 1→3 of (a, b, c), new vertex m | `on_face_split` | `on_face_split(m, [a, b, c])` |
+//! | vertex slots appended | `on_grow` | `grow(n)` |
+//! | compaction (garbage collection) of the vertex arrays | `on_compact` | `apply_remap(old_to_new)` |
 //!
-//! A new vertex id may be the next id (`== len()`, the row is appended) or an id already
-//! added with `grow`. Removed vertices keep their (stale) rows until `apply_remap` drops them;
-//! `step` ignores them meanwhile because no triangle references them.
+//! The `u32` transfer methods stay public for callers that move a survivor to the removed
+//! endpoint's position (`on_collapse(survivor, removed)`) or keep rows of their own. A new
+//! vertex id may be the next id (`== len()`, the row is appended) or an id already added with
+//! `grow`. Removed vertices keep their (stale) rows until `apply_remap` drops them; `step`
+//! ignores them meanwhile because no triangle references them.
 
-use roar_mesh::Mesh;
+use roar_mesh::{Collapse, EdgeSplit, FaceSplit, Remap, VertexStore};
 
 use super::{OptimError, Optimizer, VertexState};
 
-/// Gives the optimizer a row for every vertex slot of the mesh (new rows are zero), so the
-/// transfer calls of a block always find their rows.
-pub fn sync_optimizer_len(mesh: &Mesh, optimizer: &mut Optimizer) {
-    optimizer.grow(mesh.vertex_capacity());
-}
+/// The store calls of a [`roar_mesh::TrackedMesh`] name only vertex slots it grew the rows
+/// to, so a failing transfer is a bug in the mesh's bookkeeping.
+const ROWS_COVER_SLOTS: &str = "optimizer rows cover every vertex slot (invariant)";
 
-/// Compacts the mesh and applies the vertex remap to the optimizer rows. Rows beyond the old
-/// vertex capacity (none if [`sync_optimizer_len`] ran) are dropped. Afterwards
-/// `optimizer.len() == mesh.vertex_capacity() == mesh.n_vertices()`.
-pub fn compact_with_optimizer(mesh: &mut Mesh, optimizer: &mut Optimizer) {
-    sync_optimizer_len(mesh, optimizer);
-    let remap = mesh.compact();
-    let mut old_to_new: Vec<u32> = remap
-        .vertices
-        .iter()
-        .map(|v| v.map_or(u32::MAX, |v| v.raw()))
-        .collect();
-    old_to_new.resize(optimizer.len(), u32::MAX);
-    optimizer
-        .apply_remap(&old_to_new)
-        .expect("a mesh compaction remap is injective and sized to the optimizer (invariant)");
-    // Live vertices all map somewhere; if the mesh's last slots were dead the optimizer may be
-    // shorter than the new capacity only when nothing maps there, which cannot happen.
-    sync_optimizer_len(mesh, optimizer);
+impl VertexStore for Optimizer {
+    fn on_grow(&mut self, vertex_slots: usize) {
+        self.grow(vertex_slots);
+    }
+
+    fn on_collapse(&mut self, collapse: &Collapse) {
+        // The survivor kept its own position, so it keeps its own row.
+        let survivor = collapse.survivor.raw();
+        Optimizer::on_collapse(self, survivor, survivor).expect(ROWS_COVER_SLOTS);
+    }
+
+    fn on_edge_split(&mut self, split: &EdgeSplit) {
+        let parents = split.parents.map(|v| v.raw());
+        Optimizer::on_edge_split(self, split.new_vertex.raw(), parents, split.t)
+            .expect(ROWS_COVER_SLOTS);
+    }
+
+    fn on_face_split(&mut self, split: &FaceSplit) {
+        let parents = split.parents.map(|v| v.raw());
+        Optimizer::on_face_split(self, split.new_vertex.raw(), parents).expect(ROWS_COVER_SLOTS);
+    }
+
+    fn on_compact(&mut self, remap: &Remap) {
+        // Rows for every old slot, then the old → new map sized to the rows (rows beyond the
+        // old slots map nowhere and are dropped).
+        self.grow(remap.vertices.len());
+        let mut old_to_new: Vec<u32> = remap
+            .vertices
+            .iter()
+            .map(|v| v.map_or(u32::MAX, |v| v.raw()))
+            .collect();
+        old_to_new.resize(self.len(), u32::MAX);
+        self.apply_remap(&old_to_new)
+            .expect("a mesh compaction remap is injective and sized to the optimizer (invariant)");
+    }
 }
 
 impl Optimizer {

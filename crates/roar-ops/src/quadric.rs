@@ -1,10 +1,12 @@
-//! Garland–Heckbert quadrics and the one small dense solve behind them.
+//! Garland–Heckbert quadrics and the one small dense solve behind them, for both edge-collapse
+//! users: the QEM decimation ([`crate::decimate`]) and the loop's QSlim edge costs
+//! ([`crate::blocks::qslim`]).
 
 use glam::DVec3;
 
 /// The error quadric `E(x) = xᵀ A x + 2 bᵀ x + c` of a sum of weighted squared plane distances.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
-pub(crate) struct Quadric {
+pub struct Quadric {
     /// Upper triangle of the symmetric A: xx, xy, xz, yy, yz, zz.
     a: [f64; 6],
     b: DVec3,
@@ -13,25 +15,30 @@ pub(crate) struct Quadric {
 
 impl Quadric {
     /// `weight · (n·x + d)²` for the plane through `point` with unit normal `n`.
-    pub(crate) fn from_plane(n: DVec3, point: DVec3, weight: f64) -> Quadric {
+    pub fn from_plane(n: DVec3, point: DVec3, weight: f64) -> Quadric {
         let d = -n.dot(point);
         Quadric {
-            a: [
-                n.x * n.x,
-                n.x * n.y,
-                n.x * n.z,
-                n.y * n.y,
-                n.y * n.z,
-                n.z * n.z,
-            ]
-            .map(|x| x * weight),
+            a: outer(n).map(|x| x * weight),
             b: n * (d * weight),
             c: d * d * weight,
         }
     }
 
+    /// Adds `weight · (n·x + d)²` for the plane through `point` with unit normal `n`, in place.
+    /// The same quadric as `self.add(&Quadric::from_plane(n, point, weight))` but for the
+    /// constant term, which is rounded as `(weight·d)·d` here and `(d·d)·weight` there: the QSlim
+    /// costs and the decimation each keep their own rounding, so their outputs do not move.
+    pub fn add_plane(&mut self, n: DVec3, point: DVec3, weight: f64) {
+        let d = -n.dot(point);
+        for (x, p) in self.a.iter_mut().zip(outer(n)) {
+            *x += p * weight;
+        }
+        self.b += n * (weight * d);
+        self.c += weight * d * d;
+    }
+
     /// Sum of two quadrics.
-    pub(crate) fn add(&self, o: &Quadric) -> Quadric {
+    pub fn add(&self, o: &Quadric) -> Quadric {
         let mut a = self.a;
         for (x, y) in a.iter_mut().zip(o.a) {
             *x += y;
@@ -44,7 +51,7 @@ impl Quadric {
     }
 
     /// `E(p)`, clamped at 0 (rounding can make it slightly negative).
-    pub(crate) fn eval(&self, p: DVec3) -> f64 {
+    pub fn eval(&self, p: DVec3) -> f64 {
         let [xx, xy, xz, yy, yz, zz] = self.a;
         let ap = DVec3::new(
             xx * p.x + xy * p.y + xz * p.z,
@@ -58,7 +65,7 @@ impl Quadric {
     /// is (near) singular: `det A ≤ 1e-8 · trace(A)³` (flat or cylindrical neighbourhoods).
     /// A is positive semi-definite, so `det = λ₁λ₂λ₃` and `trace ≥ λ_max`: every matrix whose
     /// smallest eigenvalue is below `1e-8` times its largest is rejected.
-    pub(crate) fn minimizer(&self) -> Option<DVec3> {
+    pub fn minimizer(&self) -> Option<DVec3> {
         let [xx, xy, xz, yy, yz, zz] = self.a;
         let trace = xx + yy + zz;
         if !(trace > 0.0 && trace.is_finite()) {
@@ -87,10 +94,22 @@ impl Quadric {
     }
 }
 
+/// The upper triangle of `n nᵀ` (xx, xy, xz, yy, yz, zz), as a [`Quadric`] stores its A.
+fn outer(n: DVec3) -> [f64; 6] {
+    [
+        n.x * n.x,
+        n.x * n.y,
+        n.x * n.z,
+        n.y * n.y,
+        n.y * n.z,
+        n.z * n.z,
+    ]
+}
+
 /// Placement and cost of merging two vertices with quadric sum `q`: the minimiser of `q` if it
 /// exists and lies within `3·|pa − pb|` of the midpoint, else the best of `pa`, `pb` and the
 /// midpoint.
-pub(crate) fn placement(q: &Quadric, pa: DVec3, pb: DVec3) -> (DVec3, f64) {
+pub fn placement(q: &Quadric, pa: DVec3, pb: DVec3) -> (DVec3, f64) {
     let mid = 0.5 * (pa + pb);
     if let Some(p) = q.minimizer()
         && p.distance(mid) <= 3.0 * pa.distance(pb)

@@ -1,0 +1,570 @@
+//! The finish stage: the lowest-loss loop state the untangle block clears, filled to N; the
+//! final QEMs (to 2N and polish first when the mesh is larger), each followed by smoothing,
+//! data flips and the polish; then sliver flips. Every step after the QEMs goes through
+//! [`keep_if_clean`]: it is kept only if the mesh stays free of self-intersections in the
+//! input's coordinates, where it will be written.
+
+use std::convert::Infallible;
+
+use glam::DVec3;
+use roar_loss::{KnnPlanarProjector, Loss};
+use roar_mesh::Mesh;
+use roar_mesh::spatial::{Normalization, self_intersecting_faces};
+use roar_ops::blocks::smoothing::SmoothingOptions;
+use roar_ops::decimate::{DecimateOptions, DecimateStats, decimate};
+use roar_ops::finish::data_flips::{DataFlipOptions, flip_toward_target};
+use roar_ops::finish::degenerate::{DegenerateOptions, collapse_degenerate_faces};
+use roar_ops::finish::fill::fill_to_budget;
+use roar_ops::finish::genus::{HandleRemovalOptions, decimate_removing_handles};
+use roar_ops::finish::offset::offset_outward;
+use roar_ops::finish::slivers::{SliverOptions, flip_slivers};
+use roar_ops::untangle::{UntangleOptions, UntangleStats, untangle};
+
+use super::optimize::{LoopState, move_vertices, new_optimizer};
+use super::{PipelineError, ReconstructConfig, Run, RunStats, StageClock, UntangleFailure};
+
+/// Finishes from the loop's `states` with `loss` (dropped before the sliver flips) and the
+/// cloud's `projector` (for the data flips); returns the final mesh in rig coordinates.
+pub(super) fn finish(
+    states: Vec<LoopState>,
+    mut loss: Box<dyn Loss>,
+    projector: &KnnPlanarProjector,
+    normalization: &Normalization,
+    run: &mut Run,
+) -> Result<Mesh, PipelineError> {
+    let config = run.config;
+    let faces = states.last().map_or(0, |state| state.mesh.n_faces());
+    run.report("finish", config.iterations, run.stats.loss_last, faces)?;
+    let mut mesh = finish_from_best_state(states, config, &mut run.stats)?;
+    run.clock.lap("untangle");
+
+    run.report(
+        "decimate",
+        config.iterations,
+        run.stats.loss_last,
+        mesh.n_faces(),
+    )?;
+    let polishing = config.iterations > 0 && config.polish_iterations > 0;
+    for faces in finish_budgets(mesh.n_faces(), config.faces, polishing) {
+        let stats = &mut run.stats;
+        if polishing && config.final_qem_offset > 0.0 {
+            stats.offset_vertices += offset_outward(&mut mesh, config.final_qem_offset);
+            run.clock.lap("offset");
+        }
+        let decimated = final_decimation(&mut mesh, faces, config, stats)?;
+        stats.final_collapses += decimated.collapses;
+        run.clock.lap("final_qem");
+
+        if config.iterations > 0 && config.final_smoothing_sweeps > 0 {
+            mesh = smooth_if_clean(mesh, normalization, config, stats);
+            run.clock.lap("final_smoothing");
+        }
+
+        if config.iterations > 0 && config.data_flip_rounds > 0 {
+            mesh = flip_toward_cloud_if_clean(mesh, projector, normalization, config, stats);
+            run.clock.lap("data_flips");
+        }
+
+        // No Move Vertices step at all with `iterations = 0`: that run is the plain init + QEM.
+        if polishing {
+            run.report(
+                "polish",
+                config.iterations,
+                run.stats.loss_last,
+                mesh.n_faces(),
+            )?;
+            mesh = polish(
+                mesh,
+                loss.as_mut(),
+                normalization,
+                config,
+                &mut run.stats,
+                &mut run.clock,
+            )?;
+        }
+    }
+    drop(loss);
+    if config.iterations > 0 && config.sliver_quality > 0.0 {
+        mesh = remove_slivers_if_clean(mesh, normalization, config, &mut run.stats);
+        run.clock.lap("sliver_flips");
+    }
+    Ok(mesh)
+}
+
+/// Fills and untangles the loop's states in order of increasing loss (the later one first
+/// among equals) and returns the first one the untangle block clears, recording the others in
+/// `stats.untangle_failures`. Fails with the last state's unresolved face count when none
+/// clears.
+fn finish_from_best_state(
+    mut states: Vec<LoopState>,
+    config: &ReconstructConfig,
+    stats: &mut RunStats,
+) -> Result<Mesh, PipelineError> {
+    states.sort_by(|a, b| {
+        a.loss
+            .total_cmp(&b.loss)
+            .then(b.iteration.cmp(&a.iteration))
+    });
+    let mut unresolved = 0;
+    for state in states {
+        let mut mesh = state.mesh;
+        unresolved = fill_and_untangle(&mut mesh, config, stats);
+        if unresolved == 0 {
+            stats.finished_from_iteration = state.iteration;
+            return Ok(mesh);
+        }
+        stats.untangle_failures.push(UntangleFailure {
+            iteration: state.iteration,
+            unresolved_faces: unresolved,
+        });
+    }
+    Err(PipelineError::Intersections(unresolved))
+}
+
+/// Fills the mesh up to `config.faces`, runs the untangle block and fills again (its collapses
+/// may take the mesh below the budget, and the final QEM never adds faces; splits do not move
+/// any geometry, so no intersection comes back). Returns how many faces it could not clear.
+fn fill_and_untangle(mesh: &mut Mesh, config: &ReconstructConfig, stats: &mut RunStats) -> usize {
+    stats.fill_splits = fill_to_budget(mesh, config.faces);
+    let untangled = untangle(
+        mesh,
+        &UntangleOptions {
+            margin_rel: config.untangle_margin,
+            ..UntangleOptions::default()
+        },
+    );
+    record_untangle(stats, &untangled);
+    stats.fill_splits += fill_to_budget(mesh, config.faces);
+    untangled.unresolved_faces.len()
+}
+
+fn record_untangle(stats: &mut RunStats, untangled: &UntangleStats) {
+    stats.untangle_initial_pairs = untangled.initial_pairs;
+    stats.untangle_rounds = untangled.rounds;
+}
+
+/// The face counts the finish decimates to, each followed by a polish: `[2N, N]` when the
+/// polished mesh has more than 2N faces, otherwise `[N]`.
+///
+/// Why: below N = 2500 the working budget stays at its floor (5000), so the final QEM would
+/// remove most of the faces in one go, placing vertices from the working mesh's quadrics alone.
+/// Decimating to 2N first (where the working budget would be without the floor) and polishing
+/// there puts the mesh back on the target before the last halving. Measured at N = 1000
+/// (Chamfer/diag, one step → two): gpytoolbox-airplane 2.18e-3 → 2.05e-3, manifoldplus-chair
+/// 3.51e-3 → 3.12e-3, manifoldplus-table 3.29e-3 → 3.18e-3, luke-f-16 1.82e-3 → 1.78e-3,
+/// libigl-camelhead 2.95e-3 → 3.00e-3; normal cosine better on all seven meshes tried.
+fn finish_budgets(faces: usize, budget: usize, polishing: bool) -> Vec<usize> {
+    if polishing && faces > 2 * budget {
+        vec![2 * budget, budget]
+    } else {
+        vec![budget]
+    }
+}
+
+/// The guaranteed QEM to exactly `faces` (best effort only if configured). Unless
+/// `keep_topology`, handles are removed (shortest loop first, `roar_ops::finish::genus`) when the genus
+/// needs more faces than `faces` or the QEM stalls above it; each removal is noted on stderr and
+/// recorded in `stats.handles_removed`.
+fn final_decimation(
+    mesh: &mut Mesh,
+    faces: usize,
+    config: &ReconstructConfig,
+    stats: &mut RunStats,
+) -> Result<DecimateStats, PipelineError> {
+    let options = DecimateOptions {
+        best_effort: config.best_effort,
+        ..DecimateOptions::default()
+    };
+    let decimated = if config.keep_topology {
+        decimate(mesh, faces, &options)?
+    } else {
+        let (decimated, removed) = decimate_removing_handles(
+            mesh,
+            faces,
+            &options,
+            &HandleRemovalOptions::default(),
+            decimate,
+        )?;
+        for handle in &removed {
+            eprintln!(
+                "note: removed a handle to reach {faces} faces (cut along a loop of {} edges, \
+                 length {:.4} in the unit sphere; --keep-topology fails instead)",
+                handle.loop_vertices, handle.loop_length
+            );
+        }
+        stats.handles_removed.extend(removed);
+        decimated
+    };
+    if mesh.n_faces() != faces && !config.best_effort {
+        return Err(PipelineError::Internal(format!(
+            "the output has {} faces instead of {}",
+            mesh.n_faces(),
+            faces
+        )));
+    }
+    Ok(decimated)
+}
+
+/// `config.final_smoothing_sweeps` sweeps of tangential smoothing with every move limited so
+/// that no face pair starts to intersect, kept only if the result is free of self-intersections
+/// in the input's coordinates, where it will be written (as for the polish and the sliver
+/// flips).
+fn smooth_if_clean(
+    mesh: Mesh,
+    normalization: &Normalization,
+    config: &ReconstructConfig,
+    stats: &mut RunStats,
+) -> Mesh {
+    let options = SmoothingOptions {
+        guard_intersections: true,
+        ..SmoothingOptions::default()
+    };
+    let (mesh, moves) = keep_if_clean(mesh, normalization, |smoothed| {
+        (0..config.final_smoothing_sweeps)
+            .map(|_| roar_ops::blocks::smoothing::tangential_smoothing(smoothed, &options).accepted)
+            .sum()
+    });
+    stats.final_smoothing_moves += moves;
+    mesh
+}
+
+/// `config.data_flip_rounds` rounds of data-dependent flips toward the normals of the point cloud
+/// (the normal of the cloud point nearest to each sample), kept only if the result is free of
+/// self-intersections in the input's coordinates, as for the smoothing.
+fn flip_toward_cloud_if_clean(
+    mesh: Mesh,
+    cloud: &KnnPlanarProjector,
+    normalization: &Normalization,
+    config: &ReconstructConfig,
+    stats: &mut RunStats,
+) -> Mesh {
+    let target_normal = |p: DVec3| {
+        cloud
+            .nearest(p, 1)
+            .first()
+            .map(|&(i, _)| cloud.normals()[i as usize])
+    };
+    let options = DataFlipOptions {
+        max_rounds: config.data_flip_rounds,
+        ..DataFlipOptions::default()
+    };
+    let (mesh, flips) = keep_if_clean(mesh, normalization, |flipped| {
+        flip_toward_target(flipped, &target_normal, &options).accepted
+    });
+    stats.data_flips += flips;
+    mesh
+}
+
+/// `config.polish_iterations` Move Vertices steps on the final mesh, with a fresh optimizer, a
+/// learning rate falling linearly to 0 (a constant rate leaves the vertices jittering by about
+/// η·ℓ_v, which on a converged mesh is all a step does) and no blocks, so the face count and
+/// topology stay. Keeps the evaluated state with the lowest loss (the given mesh is state 0, so
+/// the polish never raises the loss), through [`try_keep_if_clean`] (the step limiter makes
+/// a clean result the rule, but may leave faces closer than the untangle margin, and undoing
+/// the normalization rounds); otherwise returns the mesh it was given.
+fn polish(
+    mesh: Mesh,
+    loss: &mut dyn Loss,
+    normalization: &Normalization,
+    config: &ReconstructConfig,
+    stats: &mut RunStats,
+    clock: &mut StageClock,
+) -> Result<Mesh, PipelineError> {
+    let steps = config.polish_iterations;
+    let (mesh, kept) = try_keep_if_clean(mesh, normalization, |polished| {
+        let mut current = polished.clone();
+        let mut optimizer = new_optimizer(&current, config)?;
+        let mut best: Option<(f64, Mesh)> = None;
+        for k in 0..steps {
+            let mut options = *optimizer.options();
+            options.lr = config.learning_rate * (steps - k) as f64 / steps as f64;
+            optimizer
+                .set_options(options)
+                .map_err(|e| PipelineError::Internal(e.to_string()))?;
+            let before = current.clone();
+            let record = move_vertices(
+                &mut current,
+                &mut optimizer,
+                loss,
+                config,
+                stats,
+                clock,
+                "polish",
+            )?;
+            if best.as_ref().is_none_or(|(l, _)| record.loss < *l) {
+                best = Some((record.loss, before));
+            }
+            stats.polish_history.push(record);
+        }
+        // One change: the mesh became its best state (possibly the state it started from).
+        Ok::<_, PipelineError>(best.map_or(0, |(_, best)| {
+            *polished = best;
+            1
+        }))
+    })?;
+    clock.lap("polish_check");
+    stats.polish_kept = kept > 0;
+    Ok(mesh)
+}
+
+/// The sliver flips of `roar_ops::finish::slivers` on the final mesh; then, for the degenerate faces
+/// they leave, the collapses of `roar_ops::finish::degenerate`, the face count restored by edge splits
+/// ([`fill_to_budget`], which moves no geometry), and the flips once more. Kept only if the result is
+/// free of self-intersections in the input's coordinates, where it will be written (everything
+/// is checked exactly in the normalized ones; undoing the normalization rounds).
+fn remove_slivers_if_clean(
+    mesh: Mesh,
+    normalization: &Normalization,
+    config: &ReconstructConfig,
+    stats: &mut RunStats,
+) -> Mesh {
+    let options = SliverOptions {
+        max_quality: config.sliver_quality,
+        ..SliverOptions::default()
+    };
+    let (mut flips, mut collapses) = (0, 0);
+    let (mesh, changes) = keep_if_clean(mesh, normalization, |cleaned| {
+        flips = flip_slivers(cleaned, &options).accepted;
+        let faces = cleaned.n_faces();
+        collapses = collapse_degenerate_faces(cleaned, &DegenerateOptions::default()).accepted;
+        if collapses > 0 {
+            fill_to_budget(cleaned, faces);
+            flips += flip_slivers(cleaned, &options).accepted;
+        }
+        flips + collapses
+    });
+    if changes > 0 {
+        stats.sliver_flips = flips;
+        stats.degenerate_collapses = collapses;
+    }
+    mesh
+}
+
+/// The finish's one pattern for a step that must not make the output intersect itself: runs
+/// `step` on a copy of `mesh` (`step` returns how many changes it made) and returns the copy
+/// and that count if it is positive and the copy is free of self-intersections in the input's
+/// coordinates ([`clean_in_output_coordinates`]); otherwise `mesh` as it was and 0. A step
+/// that fails leaves `mesh` dropped and returns its error.
+fn try_keep_if_clean<E>(
+    mesh: Mesh,
+    normalization: &Normalization,
+    step: impl FnOnce(&mut Mesh) -> Result<usize, E>,
+) -> Result<(Mesh, usize), E> {
+    let mut changed = mesh.clone();
+    let changes = step(&mut changed)?;
+    if changes == 0 || !clean_in_output_coordinates(&changed, normalization) {
+        return Ok((mesh, 0));
+    }
+    Ok((changed, changes))
+}
+
+/// [`try_keep_if_clean`] for a step that cannot fail.
+fn keep_if_clean(
+    mesh: Mesh,
+    normalization: &Normalization,
+    step: impl FnOnce(&mut Mesh) -> usize,
+) -> (Mesh, usize) {
+    let kept = try_keep_if_clean(mesh, normalization, |mesh| Ok::<_, Infallible>(step(mesh)));
+    match kept {
+        Ok(kept) => kept,
+        Err(never) => match never {},
+    }
+}
+
+/// Whether `mesh`, with the normalization undone (as it will be written), is free of
+/// self-intersections: the exact checks ran in normalized coordinates, and undoing the
+/// normalization rounds.
+fn clean_in_output_coordinates(mesh: &Mesh, normalization: &Normalization) -> bool {
+    let (mut positions, triangles) = mesh.to_triangles();
+    normalization.invert_all(&mut positions);
+    !self_intersecting_faces(&positions, &triangles).contains(&true)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use roar_mesh::EdgeId;
+    use roar_mesh::shapes::icosphere;
+    use roar_mesh::spatial::Aabb;
+    use roar_mesh::spatial::count_intersecting_faces;
+    use roar_ops::finish::fill::bisects_well;
+    use roar_ops::geometry::{DEGENERATE_QUALITY, is_degenerate, triangle_quality};
+
+    /// Faces at or above [`DEGENERATE_QUALITY`].
+    fn degenerate_faces(mesh: &Mesh) -> usize {
+        mesh.faces()
+            .filter(|&f| {
+                let corners = mesh.face_vertices(f).map(|v| mesh.position(v));
+                is_degenerate(triangle_quality(corners), DEGENERATE_QUALITY)
+            })
+            .count()
+    }
+
+    #[test]
+    fn the_finish_halves_through_2n_only_from_above_2n_and_when_polishing() {
+        assert_eq!(finish_budgets(5000, 1000, true), vec![2000, 1000]);
+        assert_eq!(finish_budgets(2000, 1000, true), vec![1000]);
+        assert_eq!(finish_budgets(10000, 5000, true), vec![5000]);
+        assert_eq!(finish_budgets(5000, 1000, false), vec![1000]);
+    }
+
+    #[test]
+    fn the_last_stage_removes_a_needle_and_keeps_the_face_count() {
+        let mut mesh = icosphere(3);
+        let e = mesh.edges().next().unwrap();
+        // Splitting an edge next to its end makes two needles (aspect ratio far above 100).
+        mesh.split_edge(e, 1e-3);
+        mesh.compact();
+        let faces = mesh.n_faces();
+        assert_eq!(degenerate_faces(&mesh), 2);
+        let mut stats = RunStats::default();
+        let config = ReconstructConfig::default();
+        let mesh = remove_slivers_if_clean(mesh, &Normalization::IDENTITY, &config, &mut stats);
+        assert_eq!(stats.degenerate_collapses, 1, "{stats:?}");
+        mesh.validate().unwrap();
+        assert_eq!(mesh.n_faces(), faces);
+        assert_eq!(degenerate_faces(&mesh), 0);
+        assert_eq!(count_intersecting_faces(&mesh), 0);
+    }
+
+    #[test]
+    fn the_fill_splits_no_edge_of_a_needle_even_when_it_is_the_longest() {
+        // A spike makes the edges at one vertex the longest of the mesh; a needle planted on
+        // one of them (split next to the spike's tip) borders the longest edges.
+        let mut mesh = icosphere(1);
+        let tip = mesh.vertices().next().unwrap();
+        mesh.set_position(tip, 1.6 * mesh.position(tip));
+        let spoke = mesh
+            .edges()
+            .find(|&e| mesh.edge_vertices(e)[0] == tip)
+            .unwrap();
+        mesh.split_edge(spoke, 1e-4);
+        assert_eq!(degenerate_faces(&mesh), 2);
+        let longest = mesh
+            .edges()
+            .max_by(|&a, &b| mesh.edge_length(a).total_cmp(&mesh.edge_length(b)))
+            .unwrap();
+        assert!(!bisects_well(&mesh, longest), "the setup lost its point");
+
+        let faces = mesh.n_faces() + 20;
+        let splits = fill_to_budget(&mut mesh, faces);
+        assert_eq!(splits, 10);
+        mesh.validate().unwrap();
+        assert_eq!(mesh.n_faces(), faces);
+        assert_eq!(degenerate_faces(&mesh), 2, "a split made a degenerate face");
+    }
+
+    /// Two unit icospheres whose centres are `distance` apart, as one mesh of two pieces.
+    fn two_spheres(distance: f64) -> Mesh {
+        let (mut positions, mut triangles) = icosphere(2).to_triangles();
+        let n = positions.len() as u32;
+        let moved: Vec<DVec3> = positions.iter().map(|p| *p + DVec3::X * distance).collect();
+        let shifted: Vec<[u32; 3]> = triangles.iter().map(|t| t.map(|v| v + n)).collect();
+        positions.extend(moved);
+        triangles.extend(shifted);
+        Mesh::from_triangles(positions, &triangles).unwrap()
+    }
+
+    #[test]
+    fn untangling_that_collapses_edges_is_filled_back_to_the_budget() {
+        // Slivers on the first sphere where it crosses the second: the untangle block collapses
+        // crossing slivers at once instead of moving them.
+        let mut mesh = two_spheres(1.9);
+        let centre = DVec3::X * 1.9;
+        let inside = |p: DVec3| (p - centre).length() < 1.0;
+        let crossing: Vec<EdgeId> = mesh
+            .edges()
+            .filter(|&e| {
+                let [a, b] = mesh.edge_vertices(e).map(|v| mesh.position(v));
+                a.x < 1.0 && inside(a) != inside(b)
+            })
+            .collect();
+        assert!(!crossing.is_empty());
+        for e in crossing {
+            mesh.split_edge(e, 0.02);
+        }
+        let faces = mesh.n_faces();
+        let config = ReconstructConfig {
+            faces,
+            ..ReconstructConfig::default()
+        };
+        let mut stats = RunStats::default();
+        let unresolved = fill_and_untangle(&mut mesh, &config, &mut stats);
+        assert_eq!(unresolved, 0);
+        // The mesh started at the budget, so every split refilled a face the untangle removed.
+        assert!(stats.untangle_initial_pairs > 0);
+        assert!(stats.fill_splits > 0, "the untangle collapsed nothing");
+        mesh.validate().unwrap();
+        assert_eq!(mesh.n_faces(), faces);
+        assert!(count_intersecting_faces(&mesh) == 0);
+    }
+
+    #[test]
+    fn the_offset_before_the_final_qem_moves_outward_without_crossing() {
+        // Two spheres 1e-3 apart: the offset (2e-3 of the 4.9 diagonal here, 1e-2 each) would
+        // push them into each other where they nearly touch, so those moves are shortened or
+        // cancelled; everywhere else every vertex moves the whole way along its normal.
+        let mut mesh = two_spheres(2.001);
+        let before = mesh.clone();
+        let moved = offset_outward(&mut mesh, 2e-3);
+        mesh.validate().unwrap();
+        assert_eq!(count_intersecting_faces(&mesh), 0);
+        assert!(moved < mesh.n_vertices() && moved > mesh.n_vertices() * 9 / 10);
+        let diagonal = Aabb::from_points(before.positions().iter().copied())
+            .unwrap()
+            .diagonal();
+        let mut full = 0;
+        for v in mesh.vertices() {
+            let centre = if before.position(v).x < 1.0005 {
+                DVec3::ZERO
+            } else {
+                DVec3::X * 2.001
+            };
+            let grown =
+                (mesh.position(v) - centre).length() - (before.position(v) - centre).length();
+            assert!(
+                grown >= -1e-12 && grown <= 2e-3 * diagonal * (1.0 + 1e-9),
+                "{grown}"
+            );
+            if grown > 2e-3 * diagonal * 0.999 {
+                full += 1;
+            }
+        }
+        assert_eq!(full, moved);
+    }
+
+    #[test]
+    fn the_run_finishes_from_the_lowest_loss_state_the_untangle_clears() {
+        // A sphere scrambled into a tangle the untangle cannot clear, with the lowest loss.
+        let mut tangle = icosphere(2);
+        for (k, p) in tangle.positions_mut().iter_mut().enumerate() {
+            let t = k as f64;
+            *p = DVec3::new((1.7 * t).sin(), (2.3 * t).cos(), (3.1 * t).sin());
+        }
+        let state = |iteration, loss, mesh: &Mesh| LoopState {
+            iteration,
+            loss,
+            mesh: mesh.clone(),
+        };
+        let apart = two_spheres(3.0);
+        let states = vec![
+            state(0, 3.0, &apart),
+            state(10, 1.0, &tangle),
+            state(20, 2.0, &apart),
+            state(30, 2.0, &apart),
+        ];
+        let config = ReconstructConfig {
+            faces: apart.n_faces(),
+            ..ReconstructConfig::default()
+        };
+        let mut stats = RunStats::default();
+        let mesh = finish_from_best_state(states, &config, &mut stats).unwrap();
+        assert_eq!(stats.untangle_failures.len(), 1);
+        assert_eq!(stats.untangle_failures[0].iteration, 10);
+        assert!(stats.untangle_failures[0].unresolved_faces > 0);
+        // Of the two clean states with the next lowest loss, the later one.
+        assert_eq!(stats.finished_from_iteration, 30);
+        assert_eq!(mesh.n_faces(), apart.n_faces());
+        assert_eq!(count_intersecting_faces(&mesh), 0);
+    }
+}

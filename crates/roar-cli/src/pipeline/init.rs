@@ -1,0 +1,74 @@
+//! The init stage: M0 (the shape's initial mesh, or a sphere), the budget check against its
+//! pieces, the target point cloud P, and M0 decimated to the working budget W.
+
+use roar_loss::{LossError, PointCloud, Shape};
+use roar_mesh::Mesh;
+use roar_ops::decimate::{DecimateOptions, decimate};
+
+use super::{InitKind, PipelineError, ReconstructConfig, Run, RunStats};
+
+/// M0 at the working budget and the shape's point cloud for it.
+pub(super) fn init(shape: &dyn Shape, run: &mut Run) -> Result<(Mesh, PointCloud), PipelineError> {
+    let config = run.config;
+    run.report("init", 0, f64::NAN, 0)?;
+    let mut mesh = initial_mesh(shape, config, &mut run.stats)?;
+    crate::budget::check_budget(
+        "faces =",
+        config.faces,
+        crate::budget::min_reachable_budget(&mesh.component_genera(), config.keep_topology),
+    )
+    .map_err(|e| PipelineError::Config(format!("{e} (for the pieces of the init)")))?;
+    run.clock.lap("init");
+
+    run.report("point_cloud", 0, f64::NAN, mesh.n_faces())?;
+    let cloud = shape.point_cloud(&mesh)?;
+    if cloud.points.is_empty() || cloud.points.len() != cloud.normals.len() {
+        return Err(PipelineError::Loss(LossError::InvalidTarget(format!(
+            "{}: the point cloud is empty or has not one normal per point",
+            shape.name()
+        ))));
+    }
+    run.stats.point_cloud = cloud.points.len();
+    run.clock.lap("point_cloud");
+
+    let budget = config.working_budget();
+    run.stats.working_budget = budget;
+    if mesh.n_faces() > budget {
+        let options = DecimateOptions {
+            best_effort: true,
+            ..DecimateOptions::default()
+        };
+        decimate(&mut mesh, budget, &options)?;
+    }
+    run.clock.lap("working_budget_qem");
+    Ok((mesh, cloud))
+}
+
+/// M0: the shape's own initial mesh (for a soup the watertight init of T′, decimated to at
+/// most `init_max_faces`), or an icosphere of radius 0.5 (`init = "sphere"`).
+fn initial_mesh(
+    shape: &dyn Shape,
+    config: &ReconstructConfig,
+    stats: &mut RunStats,
+) -> Result<Mesh, PipelineError> {
+    let mesh = match config.init {
+        InitKind::Watertight => {
+            let initial = shape.initial_mesh()?;
+            stats.init_voxel_faces = initial.raw_faces;
+            stats.init_voxels_filled_by_winding = initial.voxels_filled_by_winding;
+            initial.mesh
+        }
+        InitKind::Sphere => {
+            let mut sphere = roar_mesh::shapes::icosphere(config.sphere_level);
+            for p in sphere.positions_mut() {
+                *p *= 0.5;
+            }
+            stats.init_voxel_faces = sphere.n_faces();
+            sphere
+        }
+    };
+    stats.init_faces = mesh.n_faces();
+    stats.init_components = mesh.components().0;
+    stats.init_genus = mesh.genus();
+    Ok(mesh)
+}

@@ -1,0 +1,229 @@
+//! The optimize stage (spec §1.2, §3.2): the objective from what the shape gave, then the loop
+//! of Move Vertices steps and scheduled blocks, keeping a checkpoint state every
+//! `checkpoint_interval` iterations and the last state, each with its loss, for the finish.
+
+use roar_loss::{KnnOptions, KnnPlanarProjector, Loss, LossError, PointCloud, Shape};
+use roar_mesh::spatial::Projector;
+use roar_mesh::{Mesh, TrackedMesh};
+use roar_ops::blocks::block::{BlockContext, BlockStats};
+use roar_ops::optim::{Optimizer, OptimizerOptions};
+use roar_ops::untangle::{LimiterOptions, limit_steps};
+
+use super::prepare::Target;
+use super::{
+    IterationRecord, LossFactory, PipelineError, Prepared, ReconstructConfig, Run, RunStats,
+    ScheduledBlock, StageClock,
+};
+
+/// The loss the loop minimizes and the k-NN planar projector over the point cloud (the
+/// blocks' projector unless the shape has its own, and the data flips' normals).
+pub(super) struct Objective {
+    pub loss: Box<dyn Loss>,
+    pub projector: KnnPlanarProjector,
+}
+
+/// Builds the objective from the shape's target renders and `cloud` with `loss_factory`.
+pub(super) fn objective(
+    shape: &dyn Shape,
+    target: &Target,
+    cloud: &PointCloud,
+    loss_factory: &LossFactory,
+    run: &mut Run,
+) -> Result<Objective, PipelineError> {
+    let config = run.config;
+    let cameras = &target.cameras;
+    let renders = shape.target_renders(cameras)?;
+    if renders.len() != cameras.len() {
+        return Err(PipelineError::Loss(LossError::InvalidTarget(format!(
+            "{}: {} target renders for {} cameras",
+            shape.name(),
+            renders.len(),
+            cameras.len()
+        ))));
+    }
+    let loss = loss_factory(&Prepared {
+        cameras,
+        renders: &renders,
+        cloud,
+        signed_distance: shape.signed_distance(),
+        config,
+    })?;
+    drop(renders);
+    let projector = KnnPlanarProjector::new(
+        &cloud.points,
+        &cloud.normals,
+        &KnnOptions {
+            k: config.planar_neighbours,
+            ..KnnOptions::default()
+        },
+    )?;
+    Ok(Objective { loss, projector })
+}
+
+/// Runs `config.iterations` iterations of the loop on `mesh` (a Move Vertices step, then the
+/// blocks due) and returns the states to finish from: the checkpoints, each with the loss
+/// before its iteration's step, and the last state with its loss (NaN when there is no
+/// checkpoint to compare it with).
+pub(super) fn optimize(
+    mut mesh: Mesh,
+    loss: &mut dyn Loss,
+    block_projector: &dyn Projector,
+    blocks: &mut [ScheduledBlock],
+    run: &mut Run,
+) -> Result<Vec<LoopState>, PipelineError> {
+    let config = run.config;
+    let budget = config.working_budget();
+    let mut optimizer = new_optimizer(&mesh, config)?;
+    // The loop's state and its loss at every checkpoint iteration, to finish from.
+    let mut states: Vec<LoopState> = Vec::new();
+    run.clock.lap("loop_setup");
+
+    for iteration in 0..config.iterations {
+        let candidate = (config.checkpoint_interval > 0
+            && iteration % config.checkpoint_interval == 0)
+            .then(|| mesh.clone());
+        let record = move_vertices(
+            &mut mesh,
+            &mut optimizer,
+            loss,
+            config,
+            &mut run.stats,
+            &mut run.clock,
+            "loop",
+        )?;
+        let value = record.loss;
+        if let Some(mesh) = candidate {
+            // `value` is the loss of the state before this iteration's step.
+            states.push(LoopState {
+                iteration,
+                loss: value,
+                mesh,
+            });
+            run.clock.lap("loop_checkpoint");
+        }
+        let stats = &mut run.stats;
+        if iteration == 0 {
+            stats.loss_first = value;
+        }
+        stats.loss_last = value;
+        stats.history.push(record);
+        let context = BlockContext {
+            iteration,
+            face_budget: budget,
+            projector: Some(block_projector),
+        };
+        for scheduled in blocks.iter_mut() {
+            let due = scheduled.every > 0
+                && iteration % scheduled.every == 0
+                && !(scheduled.skip_first && iteration == 0);
+            if due {
+                let block_stats = scheduled
+                    .block
+                    .apply(&mut TrackedMesh::new(&mut mesh, &mut optimizer), &context);
+                *run.stats
+                    .block_accepted
+                    .entry(block_stats.name)
+                    .or_insert(0) += total_accepted(&block_stats);
+                run.clock
+                    .lap(&format!("loop_block_{}", scheduled.block.name()));
+            }
+        }
+        run.report("optimize", iteration, value, mesh.n_faces())?;
+    }
+    run.stats.loop_faces = mesh.n_faces();
+
+    // The last state's loss decides only when there are other states to compare with.
+    let last = if states.is_empty() {
+        f64::NAN
+    } else {
+        let triangles = compact_triangles(&mut mesh, &mut optimizer);
+        loss.value_and_grad(mesh.positions(), &triangles)?.0
+    };
+    run.stats.loss_of_last_state = last;
+    states.push(LoopState {
+        iteration: config.iterations,
+        loss: last,
+        mesh,
+    });
+    run.clock.lap("loop_loss");
+    Ok(states)
+}
+
+/// A state of the loop's mesh and its loss.
+pub(super) struct LoopState {
+    pub iteration: usize,
+    pub loss: f64,
+    pub mesh: Mesh,
+}
+
+/// A fresh optimizer for `mesh` with the configured learning rate and Laplacian weight.
+pub(super) fn new_optimizer(
+    mesh: &Mesh,
+    config: &ReconstructConfig,
+) -> Result<Optimizer, PipelineError> {
+    Optimizer::new(
+        mesh.vertex_capacity(),
+        OptimizerOptions {
+            lr: config.learning_rate,
+            laplacian_weight: config.laplacian_weight,
+            ..OptimizerOptions::default()
+        },
+    )
+    .map_err(|e| PipelineError::Config(e.to_string()))
+}
+
+/// One Move Vertices step (spec §3.2.4): the loss and its gradient on the compacted mesh, the
+/// optimizer step, then the step limiter if configured. Stage times go to `{stage}_loss`,
+/// `{stage}_step` and `{stage}_step_limiter`. Returns the loss before the step.
+pub(super) fn move_vertices(
+    mesh: &mut Mesh,
+    optimizer: &mut Optimizer,
+    loss: &mut dyn Loss,
+    config: &ReconstructConfig,
+    stats: &mut RunStats,
+    clock: &mut StageClock,
+    stage: &str,
+) -> Result<IterationRecord, PipelineError> {
+    let triangles = compact_triangles(mesh, optimizer);
+    let (value, gradient) = loss.value_and_grad(mesh.positions(), &triangles)?;
+    let record = IterationRecord {
+        loss: value,
+        terms: loss.last_terms().into_iter().collect(),
+        faces: mesh.n_faces(),
+    };
+    clock.lap(&format!("{stage}_loss"));
+    let before = config.step_limiter.then(|| mesh.positions().to_vec());
+    optimizer
+        .step(mesh.positions_mut(), &triangles, &gradient)
+        .map_err(|e| PipelineError::Internal(e.to_string()))?;
+    clock.lap(&format!("{stage}_step"));
+    if let Some(before) = before {
+        let limited = limit_steps(
+            &before,
+            mesh.positions_mut(),
+            &triangles,
+            &LimiterOptions::default(),
+        );
+        stats.steps_shortened += limited.shortened + limited.cancelled;
+        clock.lap(&format!("{stage}_step_limiter"));
+    }
+    Ok(record)
+}
+
+/// The triangles of a compact mesh (compacting it, and the optimizer with it, if needed).
+fn compact_triangles(mesh: &mut Mesh, optimizer: &mut Optimizer) -> Vec<[u32; 3]> {
+    let mut tracked = TrackedMesh::new(mesh, optimizer);
+    if tracked.vertex_capacity() != tracked.n_vertices()
+        || tracked.face_capacity() != tracked.n_faces()
+    {
+        tracked.compact();
+    }
+    mesh.faces()
+        .map(|f| mesh.face_vertices(f).map(|v| v.raw()))
+        .collect()
+}
+
+/// Accepted operations of a block, including nested blocks (the flips of Face Collapse).
+fn total_accepted(stats: &BlockStats) -> usize {
+    stats.accepted + stats.sub.iter().map(total_accepted).sum::<usize>()
+}
