@@ -2,7 +2,8 @@
 # Cross-checks roar's evaluation metrics against trimesh, MeshLab (pymeshlab) and scipy on the
 # shared test meshes; see scripts/crosscheck.py for what is compared and the tolerances.
 # Needs ROAR_TEST_DATA (the folder holding clean/ and wild/). Creates (or reuses) a virtualenv in
-# target/crosscheck-venv. Exits non-zero on any disagreement beyond tolerance.
+# target/crosscheck-venv. Usage: scripts/crosscheck.sh [ROAR] (default: a release build made
+# here). Exits non-zero on any disagreement beyond tolerance.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -26,15 +27,14 @@ if [ ! -x "$venv/bin/python" ] || ! "$venv/bin/python" -c "import trimesh, numpy
     || { echo "crosscheck: pip install failed" >&2; exit 2; }
 fi
 
-# The evaluator: `roar eval --json` when the CLI has it, otherwise roar-eval's eval_json example
-# (same library call, same JSON report).
-echo "crosscheck: building the evaluator (release)"
-if cargo build --release --quiet -p roar-cli && target/release/roar eval --help >/dev/null 2>&1; then
-  cmd=(target/release/roar eval --json)
+# The evaluator: `roar eval --json` of the binary given as the first argument, or of a release
+# build made here.
+if [ -n "${1:-}" ]; then
+  cmd=("$1" eval --json)
 else
-  echo "crosscheck: no working 'roar eval'; using roar-eval's eval_json example instead"
-  cargo build --release --quiet -p roar-eval --example eval_json
-  cmd=(target/release/examples/eval_json --json)
+  echo "crosscheck: building the evaluator (release)"
+  cargo build --release --quiet -p roar-cli
+  cmd=(target/release/roar eval --json)
 fi
 echo "crosscheck: evaluator: ${cmd[*]}"
 
