@@ -33,7 +33,7 @@ pub struct ReconstructConfig {
     /// about diag/170 on a box-like shape, on a par with alpha wrapping at α = diag/300, where
     /// `roar init`'s 128 fills the slots between a chair's slats. 256 opens narrower cavities
     /// (libigl-camelhead's ears) and costs 3–5 s more on the wild meshes, but gains less than it
-    /// gives roar's own init + QEM (`docs/evaluation.md`).
+    /// gives roar's own init + QEM (`docs/method.md`).
     pub init_resolution: usize,
     /// The init is decimated to at most this many faces (§4.1: 20k).
     pub init_max_faces: usize,
@@ -85,8 +85,8 @@ pub struct ReconstructConfig {
     /// instead of jamming against each other on one (0 = off). [INF] Not in the paper; the
     /// value is the offset CGAL's alpha wrap is run with in the evaluation (`roar_loss::
     /// point_cloud` explains the jam; at 5000 faces the normal cosine rose on every sheet of the
-    /// evaluation, the Chamfer distance grew on closely fitted ones: README, "Sheets get one plane
-    /// per side").
+    /// evaluation, the Chamfer distance grew on closely fitted ones: `docs/method.md`, "Sheets get
+    /// one plane per side").
     pub sheet_offset: f64,
     /// Sharp-edge samples from the init (§3.1 c: 30k).
     pub sharp_edge_samples: usize,
@@ -125,14 +125,14 @@ pub struct ReconstructConfig {
     /// outputs are slightly closer to the input (Chamfer/diag 0.5–1 % lower on
     /// gpytoolbox-split_mountain and libigl-camelhead at 5000 faces) but worse shaped (median
     /// aspect ratio over the 14 wild meshes 1.46 with the init at 256 voxels, against 1.26 with
-    /// the sweeps at 192; `docs/evaluation.md`).
+    /// the sweeps at 192; `docs/method.md`).
     pub final_smoothing_sweeps: usize,
     /// Rounds of data-dependent edge flips at exactly N after the smoothing, before the polish
     /// (0 = off): an edge flips when the quad's other diagonal follows the point cloud's normals
     /// better (`roar_ops::finish::data_flips`), no face gets worse than `Q = 4` (or the worse old face)
     /// and no intersection appears. [INF] Not in the paper: the valence flips, the smoothing and
     /// the final QEM choose the diagonals for the triangles' shapes and the working mesh's
-    /// quadrics, not for the target's normals (`docs/evaluation.md`).
+    /// quadrics, not for the target's normals (`docs/method.md`).
     pub data_flip_rounds: usize,
     /// Every this many iterations, keep a copy of the loop's mesh and its loss (0 = only the
     /// last state). The run finishes from the kept state with the lowest loss (the last one
