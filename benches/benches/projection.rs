@@ -188,7 +188,7 @@ fn bench_planar_loss(c: &mut Criterion) {
     let sp: Vec<DVec3> = sp.iter().map(|&p| bump(p, 0.79)).collect();
     let mut group = c.benchmark_group("planar_loss");
     group.sample_size(10);
-    // The default cap and the previous one (100k), which the default halved.
+    // The default cap and twice it (100k).
     for cap in [PlanarOptions::default().max_samples, 100_000] {
         let options = PlanarOptions {
             max_samples: cap,

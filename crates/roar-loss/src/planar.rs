@@ -601,6 +601,24 @@ fn check_mesh(positions: &[DVec3], triangles: &[[u32; 3]]) -> Result<(), LossErr
 mod tests {
     use super::*;
 
+    /// The defaults the docs of [`PlanarOptions`], its constants and [`KnnOptions`] state.
+    #[test]
+    fn documented_defaults() {
+        assert_eq!(DEFAULT_PLANAR_SCALE, 5.0);
+        assert_eq!(DEFAULT_MAX_SAMPLES, 50_000);
+        let o = PlanarOptions::default();
+        assert_eq!(o.scale, DEFAULT_PLANAR_SCALE);
+        assert_eq!(o.max_samples, DEFAULT_MAX_SAMPLES);
+        assert!(o.t2s);
+        assert_eq!(o.t2s_normal_dot, 0.95);
+        assert_eq!(PlanarOptions::raw().scale, 1.0);
+        assert_eq!(
+            (o.knn.k, o.knn.normal_dot_threshold, o.knn.blowup_guard),
+            (10, 0.01, 1.01)
+        );
+        assert_eq!(o.knn.mode, crate::knn_projector::PlanarMode::AlongNormal);
+    }
+
     #[test]
     fn vertex_normals_of_a_tetrahedron_point_outward() {
         let p = vec![
