@@ -162,6 +162,12 @@ fn main() -> anyhow::Result<()> {
         out.stats.loss_last,
         out.stats.block_accepted,
     );
+    // The pipeline's promises hold whatever the loss and blocks: `from_triangles` accepted a
+    // closed, oriented 2-manifold; the budget is exact and no face crosses another.
+    anyhow::ensure!(
+        out.triangles.len() == reconstruction.config.faces && crossing == 0,
+        "the output breaks the pipeline's promises"
+    );
     roar_io::write_mesh(&output, &TriangleSoup::new(out.positions, out.triangles))?;
     println!("wrote {}", output.display());
     Ok(())
