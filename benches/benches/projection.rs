@@ -2,7 +2,7 @@
 //! (spec §3.4 (A)) with 10k, 50k and 200k target samples against the exact ray-cast projection
 //! onto the target mesh (spec §3.4 (B)), for source meshes of about 1k, 10k and 100k faces; plus
 //! the per-evaluation cost of the planar loss (value and gradient) at 5k faces, at the default
-//! sample cap and at the previous 100k.
+//! sample cap and at 100k.
 //!
 //! Target: a bumpy sphere (icosphere(6), 81 920 faces, radius 0.8 modulated by
 //! `1 + 0.04·sin(6x)sin(6y)sin(6z)`). Sources: geodesic spheres of 980, 9 680 and 100 820 faces
@@ -188,7 +188,7 @@ fn bench_planar_loss(c: &mut Criterion) {
     let sp: Vec<DVec3> = sp.iter().map(|&p| bump(p, 0.79)).collect();
     let mut group = c.benchmark_group("planar_loss");
     group.sample_size(10);
-    // The default cap and the previous one (100k), which the default halved.
+    // The default cap and twice it (100k).
     for cap in [PlanarOptions::default().max_samples, 100_000] {
         let options = PlanarOptions {
             max_samples: cap,

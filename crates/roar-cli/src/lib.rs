@@ -1,7 +1,8 @@
 //! # roar-cli
 //!
 //! The library half of the `roar` command: one module per subcommand (argument struct plus a
-//! `run` function), and later the reconstruction pipeline that composes the other crates.
+//! `run` function), and the reconstruction pipeline that composes the other crates
+//! ([`pipeline::Reconstruction`], with replaceable losses and blocks).
 
 pub mod batch;
 pub mod budget;

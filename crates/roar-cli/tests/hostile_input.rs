@@ -160,7 +160,7 @@ fn garbage_values_are_refused_before_reading_the_input() {
         ]);
         assert_refused(&output, field);
     }
-    // clap's own usage error (exit 2), now about the value instead of "unexpected argument '-1'".
+    // clap's own usage error (exit 2), about the value rather than "unexpected argument '-1'".
     let output = roar(&["reconstruct", s(&input), "-o", s(&out), "--faces", "-10"]);
     let stderr = String::from_utf8_lossy(&output.stderr);
     assert_eq!(output.status.code(), Some(2), "{stderr}");

@@ -31,7 +31,9 @@ const CHUNK: usize = 4096;
 /// (icospheres of 320, 1280 and 5120 faces; the ratio does not drift with resolution because both
 /// scale like 1/#V). A factor 5 brings the terms to 3–4× (gap 0.01) and 0.6–0.8× (gap 0.05) at
 /// weight 1, i.e. within 10× over the working range; the planar term still fades as the gap
-/// closes (it is quadratic), the render term does not.
+/// closes (it is quadratic), the render term does not. `roar reconstruct` passes its own
+/// `planar_scale` (500): on the init of a wild mesh the raw planar gradient is far smaller
+/// against the render gradient than on this sphere (`docs/method.md`).
 pub const DEFAULT_PLANAR_SCALE: f64 = 5.0;
 
 /// Default of [`PlanarOptions::max_samples`]: 50 000 source samples per evaluation (spec
@@ -42,7 +44,7 @@ pub const DEFAULT_PLANAR_SCALE: f64 = 5.0;
 /// 8.7% at 50k, 13.5% at 25k. The samples are drawn afresh at every evaluation, so this error
 /// averages out over the iterations: in `roar reconstruct` at 5000 faces a 50k cap left the
 /// outputs as close to the input as a 100k cap (Chamfer and normal cosine within sampling noise
-/// on the wild meshes, docs/evaluation.md, fourteenth session) and made the loss evaluations
+/// on the 14 wild meshes, `docs/method.md`) and made the loss evaluations
 /// about 14 % cheaper (the k-NN queries and the t2s tree scale with the sample count).
 pub const DEFAULT_MAX_SAMPLES: usize = 50_000;
 
@@ -598,6 +600,24 @@ fn check_mesh(positions: &[DVec3], triangles: &[[u32; 3]]) -> Result<(), LossErr
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The defaults the docs of [`PlanarOptions`], its constants and [`KnnOptions`] state.
+    #[test]
+    fn documented_defaults() {
+        assert_eq!(DEFAULT_PLANAR_SCALE, 5.0);
+        assert_eq!(DEFAULT_MAX_SAMPLES, 50_000);
+        let o = PlanarOptions::default();
+        assert_eq!(o.scale, DEFAULT_PLANAR_SCALE);
+        assert_eq!(o.max_samples, DEFAULT_MAX_SAMPLES);
+        assert!(o.t2s);
+        assert_eq!(o.t2s_normal_dot, 0.95);
+        assert_eq!(PlanarOptions::raw().scale, 1.0);
+        assert_eq!(
+            (o.knn.k, o.knn.normal_dot_threshold, o.knn.blowup_guard),
+            (10, 0.01, 1.01)
+        );
+        assert_eq!(o.knn.mode, crate::knn_projector::PlanarMode::AlongNormal);
+    }
 
     #[test]
     fn vertex_normals_of_a_tetrahedron_point_outward() {

@@ -135,7 +135,7 @@ pub fn run(args: &ReconstructArgs) -> anyhow::Result<()> {
             });
         }
     };
-    // Every input `roar reconstruct` reads today is a triangle soup.
+    // Every input `roar reconstruct` reads is a triangle soup.
     let name = input.file_name().map_or_else(
         || input.display().to_string(),
         |n| n.to_string_lossy().into_owned(),

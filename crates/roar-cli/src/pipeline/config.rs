@@ -15,7 +15,8 @@ pub enum InitKind {
     Sphere,
 }
 
-/// Every knob of `roar reconstruct`.
+/// Every knob of `roar reconstruct`. Where a field's doc names its default (or `docs/method.md`
+/// does), the unit test `documented_defaults` checks that the code agrees.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct ReconstructConfig {
@@ -33,7 +34,7 @@ pub struct ReconstructConfig {
     /// about diag/170 on a box-like shape, on a par with alpha wrapping at α = diag/300, where
     /// `roar init`'s 128 fills the slots between a chair's slats. 256 opens narrower cavities
     /// (libigl-camelhead's ears) and costs 3–5 s more on the wild meshes, but gains less than it
-    /// gives roar's own init + QEM (`docs/evaluation.md`).
+    /// gives roar's own init + QEM (`docs/method.md`).
     pub init_resolution: usize,
     /// The init is decimated to at most this many faces (§4.1: 20k).
     pub init_max_faces: usize,
@@ -45,9 +46,11 @@ pub struct ReconstructConfig {
     /// took gpytoolbox-airplane's Chamfer/diag from 2.06e-3 to 1.26e-3 but libigl-camelhead's
     /// from 2.36e-3 to 3.74e-3 (`docs/evaluation.md`, "Punctured inputs").
     pub enclosure_winding_threshold: f64,
-    /// Subdivision level of the sphere init (§4.2: 2; more helps a sphere reach detail).
+    /// Subdivision level of the sphere init. Default 4 (§4.2 has 2; more helps a sphere reach
+    /// detail).
     pub sphere_level: u32,
     /// Working budget W = clamp(factor·N, min, max), never below N (OQ-11, §1.2 step 6).
+    /// Defaults: factor 2, min 5000, max 20 000.
     pub working_budget_factor: usize,
     /// Lower bound of the working budget.
     pub working_budget_min: usize,
@@ -64,7 +67,7 @@ pub struct ReconstructConfig {
     /// λ2, the planar projection loss weight (§3.2.3: 1).
     pub planar_weight: f64,
     /// Scale of the planar term before its weight (Verification note 2). Measured with
-    /// `examples/loss_balance.rs` on wild meshes' inits at 5k faces: mean per-vertex gradient of
+    /// `crates/roar-cli/examples/loss_balance.rs` on wild meshes' inits at 5k faces: mean per-vertex gradient of
     /// 3·render ≈ 3.1e-3, raw planar ≈ 1.3e-6–3.1e-6, Laplacian ≈ 3e-4–6e-4; at 500 the planar
     /// term (6e-4–1.5e-3) is within 5× of the render term instead of 500× below it.
     pub planar_scale: f64,
@@ -85,8 +88,8 @@ pub struct ReconstructConfig {
     /// instead of jamming against each other on one (0 = off). [INF] Not in the paper; the
     /// value is the offset CGAL's alpha wrap is run with in the evaluation (`roar_loss::
     /// point_cloud` explains the jam; at 5000 faces the normal cosine rose on every sheet of the
-    /// evaluation, the Chamfer distance grew on closely fitted ones: README, "Sheets get one plane
-    /// per side").
+    /// evaluation, the Chamfer distance grew on closely fitted ones: `docs/method.md`, "Sheets get
+    /// one plane per side").
     pub sheet_offset: f64,
     /// Sharp-edge samples from the init (§3.1 c: 30k).
     pub sharp_edge_samples: usize,
@@ -118,29 +121,29 @@ pub struct ReconstructConfig {
     /// 3.05e-3 / 2.16e-3). The triangles are shaped after the final QEM instead
     /// (`final_smoothing_sweeps`).
     pub smoothing_interval: usize,
-    /// Sweeps of tangential smoothing at exactly N after the final QEM, before the polish
-    /// (0 = none), each moved vertex put back on its old faces (§3.9 plus projection) and every
-    /// move limited so that no intersection appears. [INF] Not in the paper: with the sweeps
-    /// off in the loop, this is what keeps the output's triangles well shaped. Without it the
-    /// outputs are slightly closer to the input (Chamfer/diag 0.5–1 % lower on
-    /// gpytoolbox-split_mountain and libigl-camelhead at 5000 faces) but worse shaped (median
-    /// aspect ratio over the 14 wild meshes 1.46 with the init at 256 voxels, against 1.26 with
-    /// the sweeps at 192; `docs/evaluation.md`).
+    /// Sweeps of tangential smoothing at exactly N after the final QEM, before the polish (default
+    /// 3; 0 = none), each moved vertex put back on its old faces (§3.9 plus projection) and every
+    /// move limited so that no intersection appears. [INF] Not in the paper: with the sweeps off in
+    /// the loop, this is what keeps the output's triangles well shaped. Without it the outputs are
+    /// slightly closer to the input (Chamfer/diag 0.5–1 % lower on gpytoolbox-split_mountain and
+    /// libigl-camelhead at 5000 faces) but worse shaped (median aspect ratio over the 14 wild
+    /// meshes 1.46 with the init at 256 voxels, against 1.26 with the sweeps at 192;
+    /// `docs/method.md`).
     pub final_smoothing_sweeps: usize,
     /// Rounds of data-dependent edge flips at exactly N after the smoothing, before the polish
-    /// (0 = off): an edge flips when the quad's other diagonal follows the point cloud's normals
-    /// better (`roar_ops::finish::data_flips`), no face gets worse than `Q = 4` (or the worse old face)
-    /// and no intersection appears. [INF] Not in the paper: the valence flips, the smoothing and
-    /// the final QEM choose the diagonals for the triangles' shapes and the working mesh's
-    /// quadrics, not for the target's normals (`docs/evaluation.md`).
+    /// (default 5; 0 = off): an edge flips when the quad's other diagonal follows the point cloud's
+    /// normals better (`roar_ops::finish::data_flips`), no face gets worse than `Q = 4` (or the
+    /// worse old face) and no intersection appears. [INF] Not in the paper: the valence flips, the
+    /// smoothing and the final QEM choose the diagonals for the triangles' shapes and the working
+    /// mesh's quadrics, not for the target's normals (`docs/method.md`).
     pub data_flip_rounds: usize,
-    /// Every this many iterations, keep a copy of the loop's mesh and its loss (0 = only the
-    /// last state). The run finishes from the kept state with the lowest loss (the last one
-    /// included) that the untangle block can clear (`run.finished_from_iteration`,
+    /// Every this many iterations, keep a copy of the loop's mesh and its loss (default 10; 0 =
+    /// only the last state). The run finishes from the kept state with the lowest loss (the last
+    /// one included) that the untangle block can clear (`run.finished_from_iteration`,
     /// `run.untangle_failures` in the report). [INF] Not in the paper: the blocks make the loss
-    /// rise as well as fall, and after it levels off (by iteration 30–50 on the wild meshes at
-    /// 1000 faces) it can drift up (libigl-camelhead: 0.0486 at iteration 50, 0.0535 at 199);
-    /// and the last state may be a tangle the untangle cannot clear.
+    /// rise as well as fall, and after it levels off (by iteration 30–50 on the wild meshes at 1000
+    /// faces) it can drift up (libigl-camelhead: 0.0486 at iteration 50, 0.0535 at 199); and the
+    /// last state may be a tangle the untangle cannot clear.
     pub checkpoint_interval: usize,
     /// Shorten optimizer steps that would make faces intersect (`roar_ops::untangle::limit_steps`),
     /// so the loop itself keeps the mesh intersection-free where the blocks did.
@@ -158,30 +161,30 @@ pub struct ReconstructConfig {
     /// Separation margin of the untangle block, relative to the bounding-box diagonal.
     pub untangle_margin: f64,
     /// Before the final QEM, move every vertex this far (relative to the bounding-box diagonal)
-    /// outward along its normal, as far as no intersection appears (0 = off; only when the
-    /// polish runs, which moves the vertices back onto the target). [INF] Not in the paper: the
-    /// loop pulls the two sides of a thin part or of an open surface onto one sheet, where the
-    /// QEM's self-intersection veto refuses nearly every collapse and the decimation eats the
-    /// part from its rim instead (libigl-camelhead, an open surface, decimated from its
-    /// 5000-face loop mesh to 1000: 5.9 % of the input farther than 1 % of the diagonal from
-    /// the output, 0.3 % with an offset of 5e-4).
+    /// outward along its normal, as far as no intersection appears (default 5e-4; 0 = off; only
+    /// when the polish runs, which moves the vertices back onto the target). [INF] Not in the
+    /// paper: the loop pulls the two sides of a thin part or of an open surface onto one sheet,
+    /// where the QEM's self-intersection veto refuses nearly every collapse and the decimation eats
+    /// the part from its rim instead (libigl-camelhead, an open surface, decimated from its
+    /// 5000-face loop mesh to 1000: 5.9 % of the input farther than 1 % of the diagonal from the
+    /// output, 0.3 % with an offset of 5e-4).
     pub final_qem_offset: f64,
-    /// Move Vertices iterations at exactly N after the final QEM (0 = off), with the step
-    /// limiter, a learning rate falling linearly to 0 and no blocks, so the face count and
-    /// topology stay; the state with the lowest loss is kept. [INF] Not in the paper: the final
-    /// QEM places vertices at quadric minimisers of the working-budget surface, not on the
-    /// target. If the kept mesh intersects itself, the QEM output is kept (the report says so).
-    /// Runs only when `iterations > 0`, so `--iterations 0` stays the plain init + QEM.
+    /// Move Vertices iterations at exactly N after the final QEM (default 20; 0 = off), with the
+    /// step limiter, a learning rate falling linearly to 0 and no blocks, so the face count and
+    /// topology stay; the state with the lowest loss is kept. [INF] Not in the paper: the final QEM
+    /// places vertices at quadric minimisers of the working-budget surface, not on the target. If
+    /// the kept mesh intersects itself, the QEM output is kept (the report says so). Runs only when
+    /// `iterations > 0`, so `--iterations 0` stays the plain init + QEM.
     pub polish_iterations: usize,
-    /// Last step: flip the edges of faces with aspect ratio `Q = R/(2r)` above this when both
-    /// faces of the edge get better, the two are nearly coplanar (0.95; against the other face
-    /// alone when one is degenerate, above 100) and no intersection appears
-    /// (`roar_ops::finish::slivers`; 0 = off); then degenerate faces (above 100) that no flip fixes are
-    /// removed by collapsing one of their edges, and the face count is restored by edge splits
-    /// that make no degenerate face (`roar_ops::finish::degenerate`). [INF] Not in the paper: the optimization and
-    /// the polish move vertices for the losses, and the final QEM bounds only the faces it
-    /// creates, so a few caps (one angle near 180°) reach the output. Runs only when
-    /// `iterations > 0`.
+    /// Last step: flip the edges of faces with aspect ratio `Q = R/(2r)` above this when both faces
+    /// of the edge get better, the two are nearly coplanar (0.95; against the other face alone when
+    /// one is degenerate, above 100) and no intersection appears (`roar_ops::finish::slivers`;
+    /// default 10; 0 = off); then degenerate faces (above 100) that no flip fixes are removed by
+    /// collapsing one of their edges, and the face count is restored by edge splits that make no
+    /// degenerate face (`roar_ops::finish::degenerate`). [INF] Not in the paper: the optimization
+    /// and the polish move vertices for the losses, and the final QEM bounds only the faces it
+    /// creates, so a few caps (one angle near 180°) reach the output. Runs only when `iterations >
+    /// 0`.
     pub sliver_quality: f64,
     /// Write the closest mesh when the final QEM cannot reach the budget, instead of failing.
     pub best_effort: bool,
@@ -421,5 +424,56 @@ impl FieldRange {
         } else {
             span
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The defaults the field docs (and `docs/method.md`) state, so the two cannot drift apart.
+    #[test]
+    fn documented_defaults() {
+        let c = ReconstructConfig::default();
+        assert_eq!(c.seed, 43);
+        assert_eq!(c.iterations, 200);
+        assert_eq!(c.init, InitKind::Watertight);
+        assert_eq!(c.init_resolution, 192);
+        assert_eq!(c.init_max_faces, 20_000);
+        assert_eq!(c.enclosure_winding_threshold, 0.0, "off by default");
+        assert_eq!(roar_ops::init::ENCLOSURE_WINDING_THRESHOLD, 0.7);
+        assert_eq!(c.sphere_level, 4);
+        assert_eq!(
+            (
+                c.working_budget_factor,
+                c.working_budget_min,
+                c.working_budget_max
+            ),
+            (2, 5000, 20_000)
+        );
+        assert_eq!((c.views_per_axis, c.render_resolution), (6, 512));
+        assert_eq!(c.twin_ratio, 80.0);
+        assert_eq!((c.render_weight, c.planar_weight), (3.0, 1.0));
+        assert_eq!(c.planar_scale, 500.0);
+        assert_eq!(c.planar_max_samples, 50_000);
+        assert_eq!(c.planar_max_samples, roar_loss::planar::DEFAULT_MAX_SAMPLES);
+        assert_eq!(c.planar_neighbours, 10);
+        assert_eq!(c.point_cloud_samples, 200_000);
+        assert_eq!(c.sheet_offset, 1e-3);
+        assert_eq!(c.sharp_edge_samples, 30_000);
+        assert_eq!((c.learning_rate, c.laplacian_weight), (0.05, 0.02));
+        assert_eq!(c.collapse_interval, 1);
+        assert_eq!(c.collapse_fold_slack, 0.6);
+        assert_eq!(c.collapse_min_normal_size, 0.98, "on in the pipeline");
+        assert_eq!((c.split_interval, c.split_threshold), (10, 0.02));
+        assert_eq!(c.smoothing_interval, 0, "off by default");
+        assert_eq!(c.final_smoothing_sweeps, 3);
+        assert_eq!(c.data_flip_rounds, 5);
+        assert_eq!(c.checkpoint_interval, 10);
+        assert!(c.step_limiter);
+        assert!(!c.guard_intersections, "off by default");
+        assert_eq!(c.final_qem_offset, 5e-4);
+        assert_eq!(c.polish_iterations, 20);
+        assert_eq!(c.sliver_quality, 10.0);
     }
 }

@@ -231,8 +231,10 @@ pub struct Reconstruction {
     pub config: ReconstructConfig,
     /// Builds the objective (default: λ1·render + λ2·planar, spec §3.2.3).
     pub loss_factory: LossFactory,
-    /// The remeshing schedule (default: Face Collapse + flips every iteration, Face Split every
-    /// 10, tangential smoothing every 5; spec §1.2).
+    /// The remeshing schedule (default [`default_blocks`]: Face Collapse + flips every
+    /// `collapse_interval` iterations (1), Face Split every `split_interval` (10), tangential
+    /// smoothing every `smoothing_interval` (0 = off; spec §1.2 has 5, `docs/method.md` says why
+    /// not)).
     pub blocks: Vec<ScheduledBlock>,
     /// When set (by another thread, a signal handler, a binding), the run stops with
     /// [`PipelineError::Cancelled`] at its next progress report (once per iteration of the

@@ -218,3 +218,19 @@ pub fn apply_collapse(
     }
     true
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The defaults the docs of [`FaceCollapseOptions`] state: the paper's block, whose normal
+    /// size gate is off (the pipeline's `collapse_min_normal_size` switches it on at 0.98).
+    #[test]
+    fn documented_defaults() {
+        let o = FaceCollapseOptions::default();
+        assert_eq!(o.fold_slack, 0.6);
+        assert_eq!(o.min_normal_size, None);
+        assert_eq!(o.flips, Some(FlipOptions::default()));
+        assert!(!o.guard_intersections);
+    }
+}

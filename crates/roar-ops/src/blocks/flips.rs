@@ -177,3 +177,18 @@ impl Block for EdgeFlips {
         mesh.with_fixed_vertices(|mesh| flip_edges(mesh, &self.options))
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The defaults the docs of [`FlipOptions`] state (spec §3.7).
+    #[test]
+    fn documented_defaults() {
+        let o = FlipOptions::default();
+        assert_eq!((o.max_rounds, o.max_candidates_per_round), (10, 2000));
+        assert_eq!(o.min_abs_flatness, Some(0.95));
+        assert_eq!(o.normal_tolerance, 1e-8);
+        assert!(!o.guard_intersections);
+    }
+}

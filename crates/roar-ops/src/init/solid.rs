@@ -178,8 +178,8 @@ fn components(set: u8) -> usize {
 /// A pass fills the checkerboard edges if there are any, else the pinched corners, then floods
 /// the exterior again. Only voxels that pass turned solid can create new violations, so after the
 /// first full scan of each kind only the edges and corners around them are checked again: the
-/// same violations as full scans, at a fraction of the cost (a pass used to cost two full scans
-/// of the grid, and large soups need a handful of passes).
+/// same violations as full scans, at a fraction of the cost (rescanning would cost two full scans
+/// of the grid per pass, and large soups need a handful of passes).
 pub(crate) fn repair_nonmanifold(
     grid: &Grid,
     state: &mut Vec<u8>,
