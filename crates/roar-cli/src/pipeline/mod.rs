@@ -31,7 +31,7 @@ use std::time::Instant;
 use glam::DVec3;
 use roar_loss::{
     KnnOptions, Loss, LossError, PlanarLoss, PlanarOptions, PointCloud, RenderLoss, Shape,
-    ShapeError, SignedDistance, TargetOptions, WeightedSum,
+    Sdf, ShapeError, TargetOptions, WeightedSum,
 };
 use roar_mesh::spatial::Projector;
 use roar_ops::blocks::block::Block;
@@ -90,7 +90,7 @@ pub struct Prepared<'a> {
     /// The oriented target point cloud P (with the sharp-edge samples).
     pub cloud: &'a PointCloud,
     /// The shape's signed distance, if it has one.
-    pub signed_distance: Option<&'a dyn SignedDistance>,
+    pub signed_distance: Option<Arc<dyn Sdf>>,
     /// The effective configuration.
     pub config: &'a ReconstructConfig,
 }
