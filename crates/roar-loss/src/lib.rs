@@ -28,8 +28,8 @@ pub use point_cloud::{
     PointCloud, PointCloudOptions, point_cloud, point_cloud_of_soup, two_sided_faces,
 };
 pub use render_loss::RenderLoss;
-pub use sdf_loss::{SdfLoss, SdfLossOptions};
 pub use roar_mesh::spatial::{Sdf, SdfEvaluations};
+pub use sdf_loss::{SdfLoss, SdfLossOptions};
 pub use shape::{InitialMesh, Shape, ShapeError, ShapeSummary};
 pub use sharp_edges::{SharpEdge, SharpEdgeOptions, sharp_edge_samples, sharp_edges};
 pub use target::{Target, TargetOptions, TargetStats, build_target, render_views};

@@ -114,7 +114,11 @@ mod tests {
 
         loss.set_iteration(500);
         let (value, gradient) = loss.value_and_grad(&positions, &[]).unwrap();
-        let exact: f64 = positions.iter().map(|p| (p.length() - 0.5).abs()).sum::<f64>() / 3.0;
+        let exact: f64 = positions
+            .iter()
+            .map(|p| (p.length() - 0.5).abs())
+            .sum::<f64>()
+            / 3.0;
         assert!((value - exact).abs() < 1e-6, "{value} vs {exact}");
         let h = 1e-6;
         for i in 0..positions.len() {
@@ -126,7 +130,11 @@ mod tests {
                 let fd = (loss.value_and_grad(&plus, &[]).unwrap().0
                     - loss.value_and_grad(&minus, &[]).unwrap().0)
                     / (2.0 * h);
-                assert!((fd - gradient[i][axis]).abs() < 1e-5, "{fd} vs {}", gradient[i][axis]);
+                assert!(
+                    (fd - gradient[i][axis]).abs() < 1e-5,
+                    "{fd} vs {}",
+                    gradient[i][axis]
+                );
             }
         }
     }

@@ -250,7 +250,11 @@ fn sdf_init_of_a_sphere_and_two_touching_balls_is_a_closed_manifold() {
     )
     .unwrap();
     assert_eq!(assert_valid(&out), (1, 2));
-    assert_eq!(sphere.evaluations().values, 16 * 16 * 16, "one batch of cell centres");
+    assert_eq!(
+        sphere.evaluations().values,
+        16 * 16 * 16,
+        "one batch of cell centres"
+    );
     assert_eq!(sphere.evaluations().gradients, 0);
     // Two balls touching at one point: non-manifold contacts on the grid get repaired.
     let balls = FnSdf::new(|p: DVec3| {

@@ -280,8 +280,8 @@ pub struct AnalyticSdf {
 impl AnalyticSdf {
     /// Parses a `.sdf.toml` document; errors are one line naming the node (`shape.children[1]`).
     pub fn from_toml(text: &str) -> Result<Self, SdfError> {
-        let spec: FileSpec = toml::from_str(text)
-            .map_err(|e| SdfError::Analytic(e.message().replace('\n', " ")))?;
+        let spec: FileSpec =
+            toml::from_str(text).map_err(|e| SdfError::Analytic(e.message().replace('\n', " ")))?;
         Ok(Self {
             root: Node::from_spec(&spec.shape, "shape")?,
             counter: SdfCounter::default(),

@@ -75,7 +75,10 @@ pub struct RigSdf {
 
 impl RigSdf {
     fn to_input(&self, points: &[DVec3]) -> Vec<DVec3> {
-        points.iter().map(|p| self.normalization.invert(*p)).collect()
+        points
+            .iter()
+            .map(|p| self.normalization.invert(*p))
+            .collect()
     }
 }
 

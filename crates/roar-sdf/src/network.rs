@@ -166,12 +166,16 @@ impl Mlp {
                 width_from = key("dense.A");
                 ops.push(Op::Dense { a, b });
                 if kinds.len() > 2 {
-                    return Err(bad(format!("{prefix:04}: more than one layer at one prefix")));
+                    return Err(bad(format!(
+                        "{prefix:04}: more than one layer at one prefix"
+                    )));
                 }
                 continue;
             }
             let [(kind, _)] = kinds.as_slice() else {
-                return Err(bad(format!("{prefix:04}: more than one layer at one prefix")));
+                return Err(bad(format!(
+                    "{prefix:04}: more than one layer at one prefix"
+                )));
             };
             let name = kind.strip_suffix("._").unwrap_or(kind);
             if name == "squeeze_last" {
@@ -311,10 +315,7 @@ fn read_tensor<R: Read + Seek, D: Dimension>(
         },
     };
     if let Some((index, value)) = any.indexed_iter().find(|(_, v)| !v.is_finite()) {
-        return Err(bad(format!(
-            "{name} holds {value} at {:?}",
-            index.slice()
-        )));
+        return Err(bad(format!("{name} holds {value} at {:?}", index.slice())));
     }
     let shape = any.shape().to_vec();
     any.into_dimensionality::<D>().map_err(|_| {

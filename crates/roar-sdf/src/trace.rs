@@ -5,9 +5,10 @@
 //! 1. the SDF's values on a coarse grid of corners over the bounds (one batch, no gradients);
 //! 2. each pixel's ray, clipped to the bounds, marches the grid's trilinear interpolant in steps
 //!    of half a cell until it turns negative, which brackets the first crossing;
-//! 3. the bracket is confirmed with the SDF itself (its value at both ends must change sign) and
-//!    shrunk by Illinois regula falsi on the SDF's values, all rays of a view in one batch per
-//!    step;
+//! 3. the bracket is confirmed with the SDF itself (its value at both ends must change sign;
+//!    when both ends are outside, a few values inside it may find a thin part; when both are
+//!    inside, it moves back a few steps along the ray) and shrunk by
+//!    Illinois regula falsi on the SDF's values, all rays of a view in one batch per step;
 //! 4. one value-and-gradient evaluation at the root gives the normal `∇f/|∇f|`.
 //!
 //! Crossings that the grid's interpolant does not see (features thinner than about a cell) and
@@ -19,6 +20,12 @@ use glam::{DMat4, DVec3, DVec4};
 use rayon::prelude::*;
 use roar_mesh::spatial::{Aabb, Sdf};
 use roar_render::{Camera, Image};
+
+/// Field values looked at inside a bracket whose ends are both outside.
+const THIN_SAMPLES: usize = 7;
+
+/// Steps of half a cell a bracket may move back toward the ray's entry.
+const BACK_STEPS: usize = 4;
 
 /// Options of [`trace_normal_maps`].
 #[derive(Clone, Debug, PartialEq)]
@@ -105,7 +112,8 @@ impl CornerGrid {
             frac[a] = x - i;
         }
         let index = |i: usize, j: usize, k: usize| {
-            self.values[(base[0] + i) + self.dims[0] * ((base[1] + j) + self.dims[1] * (base[2] + k))]
+            self.values
+                [(base[0] + i) + self.dims[0] * ((base[1] + j) + self.dims[1] * (base[2] + k))]
         };
         let mut value = 0.0;
         for (k, wk) in [(0, 1.0 - frac[2]), (1, frac[2])] {
@@ -138,6 +146,7 @@ struct Bracket {
     pixel: usize,
     origin: DVec3,
     dir: DVec3,
+    t_in: f64,
     a: f64,
     b: f64,
     fa: f64,
@@ -163,7 +172,7 @@ pub fn trace_normal_maps(
         let pixels = camera.num_pixels();
         stats.rays += pixels;
         // 2. March the interpolant.
-        let candidates: Vec<Option<(DVec3, DVec3, f64, f64)>> = (0..pixels)
+        let candidates: Vec<Option<(DVec3, DVec3, f64, f64, f64)>> = (0..pixels)
             .into_par_iter()
             .map(|p| {
                 let (x, y) = (p as u32 % width, p as u32 / width);
@@ -175,7 +184,7 @@ pub fn trace_normal_maps(
                     let next = (t + step).min(t_out);
                     let value = grid.at(origin + next * dir);
                     if previous >= 0.0 && value < 0.0 {
-                        return Some((origin, dir, t, next));
+                        return Some((origin, dir, t_in, t, next));
                     }
                     previous = value;
                     t = next;
@@ -187,10 +196,11 @@ pub fn trace_normal_maps(
             .into_iter()
             .enumerate()
             .filter_map(|(pixel, c)| {
-                c.map(|(origin, dir, a, b)| Bracket {
+                c.map(|(origin, dir, t_in, a, b)| Bracket {
                     pixel,
                     origin,
                     dir,
+                    t_in,
                     a,
                     b,
                     fa: 0.0,
@@ -207,6 +217,56 @@ pub fn trace_normal_maps(
         sdf.values(&ends, &mut values);
         for (r, f) in brackets.iter_mut().zip(values.chunks(2)) {
             (r.fa, r.fb) = (f[0], f[1]);
+        }
+        // A bracket whose ends are both outside may hold a part thinner than the step: look
+        // for the field's first negative value at a few points inside it.
+        let thin: Vec<usize> = (0..brackets.len())
+            .filter(|&i| brackets[i].fa >= 0.0 && brackets[i].fb >= 0.0)
+            .collect();
+        let inner: Vec<DVec3> = thin
+            .iter()
+            .flat_map(|&i| {
+                let r = &brackets[i];
+                (1..=THIN_SAMPLES).map(move |k| {
+                    let t = r.a + (r.b - r.a) * k as f64 / (THIN_SAMPLES + 1) as f64;
+                    r.origin + t * r.dir
+                })
+            })
+            .collect();
+        let mut values = vec![0.0; inner.len()];
+        sdf.values(&inner, &mut values);
+        for (&i, samples) in thin.iter().zip(values.chunks(THIN_SAMPLES)) {
+            let r = &mut brackets[i];
+            if let Some(k) = samples.iter().position(|&f| f < 0.0) {
+                let t = |k: usize| r.a + (r.b - r.a) * k as f64 / (THIN_SAMPLES + 1) as f64;
+                let (a, b) = (t(k), t(k + 1));
+                r.fa = if k == 0 { r.fa } else { samples[k - 1] };
+                (r.a, r.b, r.fb) = (a, b, samples[k]);
+            }
+        }
+        // A bracket whose start is already inside: the field crossed earlier than the grid's
+        // interpolant; step back toward the ray's entry until the field is outside.
+        for _ in 0..BACK_STEPS {
+            let back: Vec<usize> = (0..brackets.len())
+                .filter(|&i| brackets[i].fa < 0.0 && brackets[i].a > brackets[i].t_in)
+                .collect();
+            if back.is_empty() {
+                break;
+            }
+            let points: Vec<DVec3> = back
+                .iter()
+                .map(|&i| {
+                    let r = &brackets[i];
+                    r.origin + (r.a - step).max(r.t_in) * r.dir
+                })
+                .collect();
+            let mut values = vec![0.0; points.len()];
+            sdf.values(&points, &mut values);
+            for (&i, &f) in back.iter().zip(&values) {
+                let r = &mut brackets[i];
+                (r.b, r.fb) = (r.a, r.fa);
+                (r.a, r.fa) = ((r.a - step).max(r.t_in), f);
+            }
         }
         let confirmed = brackets.len();
         brackets.retain(|r| r.fa >= 0.0 && r.fb < 0.0);

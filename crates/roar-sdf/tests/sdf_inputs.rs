@@ -10,8 +10,8 @@ use ndarray_npy::NpzWriter;
 use roar_mesh::spatial::{Aabb, Projector, Sdf, evaluate_with_gradients};
 use roar_render::star_cameras;
 use roar_sdf::{
-    Activation, AnalyticSdf, Mlp, SdfError, SdfProjector, SdfProjectorOptions, project_samples,
-    trace_normal_maps, TraceOptions,
+    Activation, AnalyticSdf, Mlp, SdfError, SdfProjector, SdfProjectorOptions, TraceOptions,
+    project_samples, trace_normal_maps,
 };
 
 /// Deterministic pseudo-random numbers in [-1, 1).
@@ -79,9 +79,7 @@ rotate = [90, 0, 0]
 fn analytic_gradients_match_finite_differences() {
     let sdf = AnalyticSdf::from_toml(SHAPES).unwrap();
     let mut r = rng(1);
-    let points: Vec<DVec3> = (0..2000)
-        .map(|_| 1.3 * DVec3::new(r(), r(), r()))
-        .collect();
+    let points: Vec<DVec3> = (0..2000).map(|_| 1.3 * DVec3::new(r(), r(), r())).collect();
     // Central differences straddle a kink of a min/max or a box edge at a few points: allow
     // those few, but the bulk must match closely.
     let (_, gradients) = evaluate_with_gradients(&sdf, &points);
@@ -90,17 +88,28 @@ fn analytic_gradients_match_finite_differences() {
         if worst_gradient_error(&sdf, &[*p], 1e-6) > 1e-4 {
             bad += 1;
         }
-        assert!((g.length() - 1.0).abs() < 1e-9, "not a distance gradient at {p}");
+        assert!(
+            (g.length() - 1.0).abs() < 1e-9,
+            "not a distance gradient at {p}"
+        );
     }
     assert!(bad < 20, "{bad} of 2000 gradients off");
     // Known values: inside the box's solid part, on the torus tube, in the drilled hole.
     let mut v = [0.0; 3];
     sdf.values(
-        &[DVec3::new(0.0, 0.0, 0.0), DVec3::new(0.35, 0.0, 0.0), DVec3::new(-0.8, 0.0, 0.0)],
+        &[
+            DVec3::new(0.0, 0.0, 0.0),
+            DVec3::new(0.35, 0.0, 0.0),
+            DVec3::new(-0.8, 0.0, 0.0),
+        ],
         &mut v,
     );
     assert!(v[0] > 0.0, "the cylinder drills the box's centre: {}", v[0]);
-    assert!(v[2] < 0.0, "the sphere ∩ capsule holds its centre: {}", v[2]);
+    assert!(
+        v[2] < 0.0,
+        "the sphere ∩ capsule holds its centre: {}",
+        v[2]
+    );
     assert_eq!(sdf.evaluations().values, 2000 * 6 + 3);
     assert_eq!(sdf.evaluations().gradients, 2000 * 2);
 }
@@ -110,14 +119,26 @@ fn bad_sdf_toml_files_get_one_line_errors_naming_the_node() {
     let cases = [
         ("[shape]\ntype = \"cone\"\n", "unknown type 'cone'"),
         ("[shape]\ntype = \"sphere\"\n", "needs `radius`"),
-        ("[shape]\ntype = \"sphere\"\nradius = -1\n", "radius must be finite and > 0"),
-        ("[shape]\ntype = \"sphere\"\nradius = 1\nminor = 2\n", "has no field `minor`"),
+        (
+            "[shape]\ntype = \"sphere\"\nradius = -1\n",
+            "radius must be finite and > 0",
+        ),
+        (
+            "[shape]\ntype = \"sphere\"\nradius = 1\nminor = 2\n",
+            "has no field `minor`",
+        ),
         (
             "[shape]\ntype = \"union\"\n[[shape.children]]\ntype = \"box\"\n",
             "shape.children[0]: a box needs `half_extents`",
         ),
-        ("[shape]\ntype = \"union\"\nchildren = []\n", "at least one child"),
-        ("[shape]\ntype = \"sphere\"\nradius = 1\nradiuss = 2\n", "unknown field"),
+        (
+            "[shape]\ntype = \"union\"\nchildren = []\n",
+            "at least one child",
+        ),
+        (
+            "[shape]\ntype = \"sphere\"\nradius = 1\nradiuss = 2\n",
+            "unknown field",
+        ),
         ("shape = 3", "invalid type"),
     ];
     for (text, expected) in cases {
@@ -164,7 +185,11 @@ fn network_gradients_match_finite_differences() {
             .map(|p| worst_gradient_error(&mlp, &[*p], 1e-3))
             .collect();
         let bad = errors.iter().filter(|&&e| e > 1e-2).count();
-        let allowed = if activation == Activation::Relu { 15 } else { 0 };
+        let allowed = if activation == Activation::Relu {
+            15
+        } else {
+            0
+        };
         println!("{activation:?}: {bad} of 300 gradients off by more than 1e-2");
         assert!(bad <= allowed, "{activation:?}: {bad} gradients off");
     }
@@ -217,11 +242,17 @@ fn bad_network_files_get_one_line_errors_naming_the_tensor() {
     let wrong = load_error(small_network(|t| {
         t[3].1 = Array2::<f32>::zeros((5, 1)).into_dyn();
     }));
-    assert!(wrong.contains("0002.dense.A is 5 × 1 but its input has 4 values"), "{wrong}");
+    assert!(
+        wrong.contains("0002.dense.A is 5 × 1 but its input has 4 values"),
+        "{wrong}"
+    );
     let bias = load_error(small_network(|t| {
         t[1].1 = Array1::<f32>::zeros(3).into_dyn();
     }));
-    assert!(bias.contains("0000.dense.b has 3 values but 0000.dense.A has 4 columns"), "{bias}");
+    assert!(
+        bias.contains("0000.dense.b has 3 values but 0000.dense.A has 4 columns"),
+        "{bias}"
+    );
     let missing = load_error(small_network(|t| {
         t.remove(4);
     }));
@@ -235,7 +266,10 @@ fn bad_network_files_get_one_line_errors_naming_the_tensor() {
     }));
     assert!(dims.contains("0000.dense.A has shape [3, 4, 1]"), "{dims}");
     let unknown = load_error(small_network(|t| t[2].0 = "0001.gelu._"));
-    assert!(unknown.contains("0001.gelu._: unknown layer 'gelu'"), "{unknown}");
+    assert!(
+        unknown.contains("0001.gelu._: unknown layer 'gelu'"),
+        "{unknown}"
+    );
     let input = load_error(small_network(|t| {
         t[0].1 = Array2::<f32>::zeros((2, 4)).into_dyn();
     }));
@@ -260,13 +294,19 @@ fn traced_normal_maps_of_a_sphere_hit_it_with_its_normals() {
     assert_eq!(stats.rays, 4 * 48 * 48);
     // Grazing rays at the silhouette whose grid bracket the sphere does not confirm stay
     // background: a sliver of the silhouette.
-    assert!(stats.hits > 0 && stats.unconfirmed * 30 < stats.hits, "{stats:?}");
+    assert!(
+        stats.hits > 0 && stats.unconfirmed * 30 < stats.hits,
+        "{stats:?}"
+    );
     // Each hit pixel's normal faces its camera; the covered fraction is the sphere's disc
     // seen from distance 10 through the rig's frustum (half-extent 1 at distance 10).
     for (image, camera) in images.iter().zip(&cameras) {
         let covered = image.iter().filter(|p| p[3] > 0.0).count() as f64;
         let expected = std::f64::consts::PI * 0.6 * 0.6 / 4.0 * (48.0 * 48.0);
-        assert!((covered / expected - 1.0).abs() < 0.1, "{covered} vs {expected}");
+        assert!(
+            (covered / expected - 1.0).abs() < 0.1,
+            "{covered} vs {expected}"
+        );
         let to_camera = camera.position().normalize();
         for p in image.iter().filter(|p| p[3] > 0.0) {
             let n = DVec3::new(p[0] as f64, p[1] as f64, p[2] as f64);
