@@ -172,10 +172,10 @@ pub fn trace_normal_maps(
         let pixels = camera.num_pixels();
         stats.rays += pixels;
         // 2. March the interpolant.
-        let candidates: Vec<Option<(DVec3, DVec3, f64, f64, f64)>> = (0..pixels)
+        let mut brackets: Vec<Bracket> = (0..pixels)
             .into_par_iter()
-            .map(|p| {
-                let (x, y) = (p as u32 % width, p as u32 / width);
+            .filter_map(|pixel| {
+                let (x, y) = (pixel as u32 % width, pixel as u32 / width);
                 let (origin, dir) = pixel_ray(&inverse, camera, x, y);
                 let (t_in, t_out) = bounds.ray_interval(origin, dir)?;
                 let mut t = t_in;
@@ -184,28 +184,21 @@ pub fn trace_normal_maps(
                     let next = (t + step).min(t_out);
                     let value = grid.at(origin + next * dir);
                     if previous >= 0.0 && value < 0.0 {
-                        return Some((origin, dir, t_in, t, next));
+                        return Some(Bracket {
+                            pixel,
+                            origin,
+                            dir,
+                            t_in,
+                            a: t,
+                            b: next,
+                            fa: 0.0,
+                            fb: 0.0,
+                        });
                     }
                     previous = value;
                     t = next;
                 }
                 None
-            })
-            .collect();
-        let mut brackets: Vec<Bracket> = candidates
-            .into_iter()
-            .enumerate()
-            .filter_map(|(pixel, c)| {
-                c.map(|(origin, dir, t_in, a, b)| Bracket {
-                    pixel,
-                    origin,
-                    dir,
-                    t_in,
-                    a,
-                    b,
-                    fa: 0.0,
-                    fb: 0.0,
-                })
             })
             .collect();
         // 3. Confirm with the SDF.
