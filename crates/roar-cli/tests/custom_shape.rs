@@ -5,11 +5,12 @@
 use std::borrow::Cow;
 use std::cell::Cell;
 use std::rc::Rc;
+use std::sync::Arc;
 
 use glam::DVec3;
 use roar_cli::pipeline::{Prepared, ReconstructConfig, Reconstruction, default_loss};
 use roar_loss::{
-    InitialMesh, PointCloud, Shape, ShapeError, ShapeSummary, SignedDistance, render_views,
+    InitialMesh, PointCloud, Sdf, SdfEvaluations, Shape, ShapeError, ShapeSummary, render_views,
 };
 use roar_mesh::Mesh;
 use roar_mesh::shapes::icosphere;
@@ -25,18 +26,26 @@ struct AnalyticSphere {
     radius: f64,
     prepared_with: usize,
     projector: SphereProjector,
-    distance: RigSphereDistance,
+    distance: Arc<RigSphereDistance>,
 }
 
 /// `f(p) = |p| − RIG_RADIUS`, in rig coordinates.
 struct RigSphereDistance;
 
-impl SignedDistance for RigSphereDistance {
-    fn evaluate(&self, points: &[DVec3], values: &mut [f64], gradients: &mut [DVec3]) {
+impl Sdf for RigSphereDistance {
+    fn values(&self, points: &[DVec3], values: &mut [f64]) {
+        for (p, f) in points.iter().zip(values) {
+            *f = p.length() - RIG_RADIUS;
+        }
+    }
+    fn values_and_gradients(&self, points: &[DVec3], values: &mut [f64], gradients: &mut [DVec3]) {
         for ((p, f), g) in points.iter().zip(values).zip(gradients) {
             *f = p.length() - RIG_RADIUS;
             *g = p.normalize_or_zero();
         }
+    }
+    fn evaluations(&self) -> SdfEvaluations {
+        SdfEvaluations::default()
     }
 }
 
@@ -50,7 +59,7 @@ impl AnalyticSphere {
                 center: DVec3::ZERO,
                 radius: RIG_RADIUS,
             },
-            distance: RigSphereDistance,
+            distance: Arc::new(RigSphereDistance),
         }
     }
 }
@@ -117,8 +126,8 @@ impl Shape for AnalyticSphere {
         )?))
     }
 
-    fn signed_distance(&self) -> Option<&dyn SignedDistance> {
-        Some(&self.distance)
+    fn signed_distance(&self) -> Option<Arc<dyn Sdf>> {
+        Some(self.distance.clone())
     }
 
     fn projector(&self) -> Option<&dyn Projector> {

@@ -96,6 +96,7 @@ fn the_flag_refuses_a_non_png_name_before_any_work() {
         quiet: true,
         force: false,
         keep_topology: false,
+        bounds: None,
     };
     let message = roar_cli::commands::reconstruct::run(&args)
         .unwrap_err()

@@ -19,6 +19,7 @@ use rayon::prelude::*;
 
 pub mod point_cloud;
 pub mod render_loss;
+pub mod sdf_loss;
 pub mod shape;
 pub mod sharp_edges;
 pub mod target;
@@ -27,7 +28,9 @@ pub use point_cloud::{
     PointCloud, PointCloudOptions, point_cloud, point_cloud_of_soup, two_sided_faces,
 };
 pub use render_loss::RenderLoss;
-pub use shape::{InitialMesh, Shape, ShapeError, ShapeSummary, SignedDistance};
+pub use roar_mesh::spatial::{Sdf, SdfEvaluations};
+pub use sdf_loss::{SdfLoss, SdfLossOptions};
+pub use shape::{InitialMesh, Shape, ShapeError, ShapeSummary};
 pub use sharp_edges::{SharpEdge, SharpEdgeOptions, sharp_edge_samples, sharp_edges};
 pub use target::{Target, TargetOptions, TargetStats, build_target, render_views};
 
@@ -65,6 +68,13 @@ pub trait Loss: Send {
     /// made of one term returns nothing: its value is the total).
     fn last_terms(&self) -> Vec<(&'static str, f64)> {
         Vec::new()
+    }
+
+    /// Tells the loss which iteration of the loop the next evaluations belong to (a term that
+    /// switches on late, like the SDF loss, reads it; the finish passes the loop's iteration
+    /// count). The default ignores it.
+    fn set_iteration(&mut self, iteration: usize) {
+        let _ = iteration;
     }
 }
 
@@ -115,6 +125,12 @@ impl Loss for WeightedSum {
             }
         }
         Ok((total, gradient))
+    }
+
+    fn set_iteration(&mut self, iteration: usize) {
+        for (_, loss) in &mut self.terms {
+            loss.set_iteration(iteration);
+        }
     }
 
     fn last_terms(&self) -> Vec<(&'static str, f64)> {

@@ -18,10 +18,10 @@
 //! bounds, and triangles are ordered counter-clockwise seen from outside.
 
 use std::borrow::Cow;
+use std::sync::Arc;
 
-use glam::DVec3;
 use roar_mesh::Mesh;
-use roar_mesh::spatial::{Normalization, Projector};
+use roar_mesh::spatial::{Normalization, Projector, Sdf};
 use roar_render::{Camera, Image};
 
 use crate::{LossError, PointCloud};
@@ -57,17 +57,6 @@ pub struct ShapeSummary {
     pub target_faces: usize,
     /// Inward twins a soup's clean-up dropped.
     pub twins_dropped: usize,
-}
-
-/// A signed distance `f` with its gradient, evaluated in batches: negative inside the solid,
-/// positive outside, zero on the surface, in rig coordinates.
-///
-/// This is the slot the SDF losses and projectors plug into; implementations must be
-/// deterministic and may evaluate a batch in parallel.
-pub trait SignedDistance: Sync {
-    /// Writes `f(p)` into `values[i]` and `∇f(p)` into `gradients[i]` for every `points[i]`.
-    /// The three slices have the same length.
-    fn evaluate(&self, points: &[DVec3], values: &mut [f64], gradients: &mut [DVec3]);
 }
 
 /// One kind of input, as the reconstruction pipeline sees it (module docs: order of calls,
@@ -110,8 +99,9 @@ pub trait Shape {
     /// [`Shape::prepare`]); each image is `width × height` of its camera.
     fn target_renders(&self, cameras: &[Camera]) -> Result<Cow<'_, [Image]>, ShapeError>;
 
-    /// The shape's signed distance, if it has one (SDF inputs do; a soup does not).
-    fn signed_distance(&self) -> Option<&dyn SignedDistance> {
+    /// The shape's signed distance in rig coordinates ([`Sdf`]: negative inside), if it has one
+    /// (SDF inputs do; a soup does not). Shared, so a loss can keep it.
+    fn signed_distance(&self) -> Option<Arc<dyn Sdf>> {
         None
     }
 

@@ -5,7 +5,7 @@ mod common;
 
 use common::{Soup, append, box_soup, check_closed_manifold, count_self_intersections};
 use glam::DVec3;
-use roar_mesh::spatial::TriangleBvh;
+use roar_mesh::spatial::{FnSdf, Sdf, TriangleBvh};
 use roar_ops::init::{
     InitError, InitOptions, SdfInitOptions, WatertightInit, sdf_init, watertight_init,
 };
@@ -238,7 +238,7 @@ fn bad_inputs_are_errors_not_panics() {
 
 #[test]
 fn sdf_init_of_a_sphere_and_two_touching_balls_is_a_closed_manifold() {
-    let sphere = |p: DVec3| p.length() - 0.7;
+    let sphere = FnSdf::new(|p: DVec3| p.length() - 0.7);
     let out = sdf_init(
         &sphere,
         DVec3::splat(-1.0),
@@ -250,12 +250,18 @@ fn sdf_init_of_a_sphere_and_two_touching_balls_is_a_closed_manifold() {
     )
     .unwrap();
     assert_eq!(assert_valid(&out), (1, 2));
+    assert_eq!(
+        sphere.evaluations().values,
+        16 * 16 * 16,
+        "one batch of cell centres"
+    );
+    assert_eq!(sphere.evaluations().gradients, 0);
     // Two balls touching at one point: non-manifold contacts on the grid get repaired.
-    let balls = |p: DVec3| {
+    let balls = FnSdf::new(|p: DVec3| {
         let a = (p - DVec3::splat(-0.3)).length() - 0.52;
         let b = (p - DVec3::splat(0.3)).length() - 0.52;
         a.min(b)
-    };
+    });
     let out = sdf_init(
         &balls,
         DVec3::splat(-1.0),
@@ -266,7 +272,7 @@ fn sdf_init_of_a_sphere_and_two_touching_balls_is_a_closed_manifold() {
     check_closed_manifold(&out.positions, &out.triangles).unwrap();
     assert!(
         sdf_init(
-            &|_| 1.0,
+            &FnSdf::new(|_| 1.0),
             DVec3::ZERO,
             DVec3::ONE,
             &SdfInitOptions::default()

@@ -231,6 +231,7 @@ fn reconstruct_args(
         force: false,
         preview: None,
         keep_topology: false,
+        bounds: None,
     }
 }
 

@@ -13,12 +13,20 @@ use roar_eval::{EvalOptions, Report};
 use serde::Serialize;
 
 use crate::checks::check_paths;
-use crate::pipeline::{InitKind, Progress, ReconstructConfig, Reconstruction, RunStats, SoupShape};
+use glam::DVec3;
+use roar_mesh::spatial::{Aabb, evaluate_with_gradients};
+
+use crate::pipeline::sdf::{DEFAULT_BOUNDS, SdfReport};
+use crate::pipeline::{
+    InitKind, Progress as PipelineProgress, ReconstructConfig, Reconstruction, RunStats, SdfShape,
+    SoupShape,
+};
 
 /// Arguments of `roar reconstruct`.
 #[derive(Args, Debug)]
 pub struct ReconstructArgs {
-    /// Any triangle soup (OBJ, PLY, STL or OFF).
+    /// Any triangle soup (OBJ, PLY, STL or OFF), or a signed distance function: a neural MLP
+    /// (`.npz`) or an analytic shape (`.sdf.toml`), negative inside (`docs/sdf.md`).
     pub input: Option<PathBuf>,
     /// Where to write the result (format by extension).
     #[arg(short, long)]
@@ -63,6 +71,32 @@ pub struct ReconstructArgs {
     /// Run even when the estimated memory of the budget exceeds what this machine has.
     #[arg(long)]
     pub force: bool,
+    /// Box to reconstruct an SDF input in, `xmin,ymin,zmin,xmax,ymax,zmax` (default
+    /// `-1.1,-1.1,-1.1,1.1,1.1,1.1`); it must hold the zero set.
+    #[arg(long, value_parser = parse_bounds, allow_hyphen_values = true)]
+    pub bounds: Option<Aabb>,
+}
+
+/// Parses `--bounds`: six finite numbers, each max above its min.
+fn parse_bounds(text: &str) -> Result<Aabb, String> {
+    let numbers: Vec<f64> = text
+        .split(',')
+        .map(|t| t.trim().parse::<f64>().map_err(|e| format!("{t:?}: {e}")))
+        .collect::<Result<_, _>>()?;
+    let [x0, y0, z0, x1, y1, z1] = numbers[..] else {
+        return Err(format!(
+            "six numbers xmin,ymin,zmin,xmax,ymax,zmax, not {}",
+            numbers.len()
+        ));
+    };
+    let bounds = Aabb {
+        min: DVec3::new(x0, y0, z0),
+        max: DVec3::new(x1, y1, z1),
+    };
+    if !bounds.min.is_finite() || !bounds.max.is_finite() || !bounds.min.cmplt(bounds.max).all() {
+        return Err("finite numbers with each max above its min".into());
+    }
+    Ok(bounds)
 }
 
 /// The JSON report of one reconstruction.
@@ -76,14 +110,31 @@ pub struct ReconstructReport {
     pub seed: u64,
     /// Seconds for the whole command, up to writing the files.
     pub seconds_total: f64,
-    /// Metrics of the input as read (self-intersections skipped: soups can be huge).
-    pub input_metrics: Report,
+    /// Metrics of the input as read (self-intersections skipped: soups can be huge); none for an
+    /// SDF input.
+    pub input_metrics: Option<Report>,
     /// Metrics of the output, with fidelity against the raw input.
     pub output_metrics: Report,
     /// Pipeline figures and per-stage timings.
     pub run: RunStats,
     /// The effective configuration.
     pub config: ReconstructConfig,
+    /// For an SDF input: its evaluations by stage and how far the output is from its zero set.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub sdf: Option<SdfRunReport>,
+}
+
+/// What a reconstruction of an SDF input adds to the report.
+#[derive(Serialize)]
+pub struct SdfRunReport {
+    /// Evaluations by stage and the tracer's figures.
+    #[serde(flatten)]
+    pub evaluations: SdfReport,
+    /// Mean first-order distance `|f|/|∇f|` of the output's vertices from the zero set, in the
+    /// input's units (evaluated after the run, not counted above).
+    pub output_distance_mean: f64,
+    /// Largest such distance.
+    pub output_distance_max: f64,
 }
 
 /// Runs `roar reconstruct`.
@@ -119,37 +170,21 @@ pub fn run(args: &ReconstructArgs) -> anyhow::Result<()> {
     check_paths(&inputs, &outputs)?;
     roar_io::MeshFormat::for_writing(output)?;
     let started = Instant::now();
+    if roar_sdf::is_sdf_path(input) {
+        return run_sdf(args, config, input, started);
+    }
     let soup = roar_io::read_mesh(input)?;
     check_resources(&config, soup.triangles.len(), args.force)?;
 
-    let bar = progress_bar(args.quiet, config.iterations);
-    let mut lines = ProgressLines::new(args.quiet || bar.is_some());
-    let mut on_progress = |p: &Progress| {
-        lines.report(p);
-        if let Some(bar) = &bar {
-            bar.set_position(p.iteration as u64);
-            bar.set_message(if p.loss.is_finite() {
-                format!("{:<10} loss {:.5} faces {}", p.stage, p.loss, p.faces)
-            } else {
-                format!("{:<10} faces {}", p.stage, p.faces)
-            });
-        }
-    };
-    // Every input `roar reconstruct` reads is a triangle soup.
-    let name = input.file_name().map_or_else(
-        || input.display().to_string(),
-        |n| n.to_string_lossy().into_owned(),
-    );
-    let mut shape = SoupShape::new(name, &soup.positions, &soup.triangles, &config);
+    let mut progress = Progress::new(args.quiet, config.iterations);
+    let mut shape = SoupShape::new(file_name(input), &soup.positions, &soup.triangles, &config);
     let mut reconstruction = Reconstruction::new(config.clone());
     let result = reconstruction
-        .run(&mut shape, &mut on_progress)
+        .run(&mut shape, &mut |p| progress.report(p))
         .with_context(|| format!("{}: reconstruction failed", input.display()));
     // The prepared target and its renders are not needed for the report.
     drop(shape);
-    if let Some(bar) = &bar {
-        bar.finish_and_clear();
-    }
+    progress.finish();
     let result = result?;
 
     let out_soup = roar_io::TriangleSoup::new(result.positions, result.triangles);
@@ -170,11 +205,28 @@ pub fn run(args: &ReconstructArgs) -> anyhow::Result<()> {
         output: output.display().to_string(),
         seed: config.seed,
         seconds_total: started.elapsed().as_secs_f64(),
-        input_metrics,
+        input_metrics: Some(input_metrics),
         output_metrics,
         run: result.stats,
         config,
+        sdf: None,
     };
+    write_outputs(
+        args,
+        &report,
+        &out_soup,
+        Some((&soup.positions, &soup.triangles)),
+    )
+}
+
+/// Writes the mesh and the report (all or nothing), the preview, and prints the report.
+fn write_outputs(
+    args: &ReconstructArgs,
+    report: &ReconstructReport,
+    out_soup: &roar_io::TriangleSoup,
+    input_soup: Option<(&[DVec3], &[[u32; 3]])>,
+) -> anyhow::Result<()> {
+    let output = args.output.as_ref().context("-o OUTPUT is required")?;
     for failure in &report.run.untangle_failures {
         eprintln!(
             "note: {} faces of the loop's state at iteration {} could not be untangled; tried the \
@@ -182,24 +234,19 @@ pub fn run(args: &ReconstructArgs) -> anyhow::Result<()> {
             failure.unresolved_faces, failure.iteration
         );
     }
-    let json = serde_json::to_string_pretty(&report)?;
+    let json = serde_json::to_string_pretty(report)?;
     // The mesh and the report are written all or nothing.
     let others: Vec<(&std::path::Path, &[u8])> = args
         .report
         .iter()
         .map(|path| (path.as_path(), json.as_bytes()))
         .collect();
-    roar_io::write_mesh_and_files(
-        output,
-        &out_soup,
-        &roar_io::WriteOptions::default(),
-        &others,
-    )?;
-    if let Some(preview) = &args.preview {
+    roar_io::write_mesh_and_files(output, out_soup, &roar_io::WriteOptions::default(), &others)?;
+    if let (Some(preview), Some(input)) = (&args.preview, input_soup) {
         let losses: Vec<f64> = report.run.history.iter().map(|r| r.loss).collect();
         crate::preview::write_preview(
             preview,
-            (&soup.positions, &soup.triangles),
+            input,
             (&out_soup.positions, &out_soup.triangles),
             &losses,
             &crate::preview::PreviewOptions::default(),
@@ -217,17 +264,104 @@ pub fn run(args: &ReconstructArgs) -> anyhow::Result<()> {
     Ok(())
 }
 
+/// The file name of `path` for messages and reports.
+fn file_name(path: &std::path::Path) -> String {
+    path.file_name().map_or_else(
+        || path.display().to_string(),
+        |n| n.to_string_lossy().into_owned(),
+    )
+}
+
+/// Reconstructs an SDF input (`.npz`, `.sdf.toml`): reads the field (one-line errors, nothing
+/// written on failure), runs the pipeline on its [`SdfShape`] inside `--bounds`, and reports the
+/// field's evaluations and how far the output's vertices are from the zero set.
+fn run_sdf(
+    args: &ReconstructArgs,
+    config: ReconstructConfig,
+    input: &std::path::Path,
+    started: Instant,
+) -> anyhow::Result<()> {
+    if args.preview.is_some() {
+        anyhow::bail!(
+            "--preview pictures a soup input; {} is an SDF",
+            input.display()
+        );
+    }
+    let field =
+        roar_sdf::load_sdf(input).map_err(|e| anyhow::anyhow!("{}: {e}", input.display()))?;
+    check_resources(&config, 0, args.force)?;
+    let bounds = args.bounds.unwrap_or(DEFAULT_BOUNDS);
+    let mut progress = Progress::new(args.quiet, config.iterations);
+    let mut shape = SdfShape::new(file_name(input), field.clone(), bounds, &config);
+    let mut reconstruction = Reconstruction::new(config.clone());
+    let result = reconstruction
+        .run(&mut shape, &mut |p| progress.report(p))
+        .with_context(|| format!("{}: reconstruction failed", input.display()));
+    progress.finish();
+    let result = result?;
+    let evaluations = shape.report();
+    let (values, gradients) = evaluate_with_gradients(field.as_ref(), &result.positions);
+    let distances: Vec<f64> = values
+        .iter()
+        .zip(&gradients)
+        .map(|(f, g)| f.abs() / g.length())
+        .collect();
+    let out_soup = roar_io::TriangleSoup::new(result.positions, result.triangles);
+    let output_metrics = roar_eval::evaluate(
+        &out_soup.positions,
+        &out_soup.triangles,
+        None,
+        &EvalOptions::default(),
+    )?;
+    let report = ReconstructReport {
+        input: input.display().to_string(),
+        output: args
+            .output
+            .as_ref()
+            .map(|o| o.display().to_string())
+            .unwrap_or_default(),
+        seed: config.seed,
+        seconds_total: started.elapsed().as_secs_f64(),
+        input_metrics: None,
+        output_metrics,
+        run: result.stats,
+        config,
+        sdf: Some(SdfRunReport {
+            evaluations,
+            output_distance_mean: distances.iter().sum::<f64>() / distances.len().max(1) as f64,
+            output_distance_max: distances.iter().copied().fold(0.0, f64::max),
+        }),
+    };
+    write_outputs(args, &report, &out_soup, None)
+}
+
 /// Defaults, then the TOML file, then the flags.
+/// The defaults are the SDF schedule's ([`ReconstructConfig::sdf_defaults`]) for an SDF input.
 pub fn effective_config(args: &ReconstructArgs) -> anyhow::Result<ReconstructConfig> {
+    let sdf_input = args.input.as_deref().is_some_and(roar_sdf::is_sdf_path);
+    let defaults = if sdf_input {
+        ReconstructConfig::sdf_defaults()
+    } else {
+        ReconstructConfig::default()
+    };
     let mut config = match &args.config {
         Some(path) => {
             let text = std::fs::read_to_string(path)
                 .with_context(|| format!("cannot read {}", path.display()))?;
-            toml::from_str(&text).map_err(|e| {
+            let one_line = |e: toml::de::Error| {
                 anyhow::anyhow!("{}: {}", path.display(), e.to_string().replace('\n', " "))
-            })?
+            };
+            let file: ReconstructConfig = toml::from_str(&text).map_err(one_line)?;
+            if sdf_input {
+                // The file's keys over the SDF defaults rather than over the soup's.
+                let mut table = toml::Table::try_from(&defaults)?;
+                table.extend(toml::from_str::<toml::Table>(&text).map_err(one_line)?);
+                table.try_into().map_err(one_line)?
+            } else {
+                file
+            }
         }
-        None => ReconstructConfig::default(),
+        None => defaults,
     };
     if let Some(faces) = args.faces {
         config.faces = faces;
@@ -260,6 +394,38 @@ pub fn effective_config(args: &ReconstructArgs) -> anyhow::Result<ReconstructCon
         config.keep_topology = true;
     }
     Ok(config)
+}
+
+/// Progress of a run on stderr: a bar on a terminal, otherwise plain lines now and then.
+struct Progress {
+    bar: Option<ProgressBar>,
+    lines: ProgressLines,
+}
+
+impl Progress {
+    fn new(quiet: bool, iterations: usize) -> Self {
+        let bar = progress_bar(quiet, iterations);
+        let lines = ProgressLines::new(quiet || bar.is_some());
+        Self { bar, lines }
+    }
+
+    fn report(&mut self, p: &PipelineProgress) {
+        self.lines.report(p);
+        if let Some(bar) = &self.bar {
+            bar.set_position(p.iteration as u64);
+            bar.set_message(if p.loss.is_finite() {
+                format!("{:<10} loss {:.5} faces {}", p.stage, p.loss, p.faces)
+            } else {
+                format!("{:<10} faces {}", p.stage, p.faces)
+            });
+        }
+    }
+
+    fn finish(&self) {
+        if let Some(bar) = &self.bar {
+            bar.finish_and_clear();
+        }
+    }
 }
 
 /// A progress bar when stderr is a terminal and not `--quiet`.
@@ -297,7 +463,7 @@ impl ProgressLines {
         }
     }
 
-    fn report(&mut self, p: &Progress) {
+    fn report(&mut self, p: &PipelineProgress) {
         let now = Instant::now();
         let due = self.last.is_none_or(|last| now - last >= Self::EVERY);
         if self.off || !due {

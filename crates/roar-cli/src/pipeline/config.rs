@@ -192,6 +192,31 @@ pub struct ReconstructConfig {
     /// stalls on the link condition) the run fails with the QEM's named error instead of
     /// removing handles (`roar_ops::finish::genus`; DESIGN.md §2).
     pub keep_topology: bool,
+    /// Weight of the SDF projection loss (§5: 0.1), in the objective only for inputs with a
+    /// signed distance (`roar_loss::SdfLoss`).
+    pub sdf_loss_weight: f64,
+    /// Loop iteration from which the SDF loss is on (§5: 500 of the SDF schedule's 700).
+    pub sdf_loss_start: usize,
+    /// `ε` of the SDF loss's projection `v − f ∇f/(|∇f|² + ε)`.
+    pub sdf_loss_epsilon: f64,
+    /// Cells along the longest side of an SDF input's bounds for its voxel init (§4.3: 64).
+    pub sdf_init_resolution: usize,
+    /// Cells of the grid that brackets the zero set for an SDF input's traced target renders
+    /// (`roar_sdf::trace`): features thinner than about one cell can be missed.
+    pub sdf_trace_grid: usize,
+    /// Regula falsi steps per traced pixel of an SDF input.
+    pub sdf_trace_refine_steps: usize,
+    /// First-order steps of an SDF input's projections: the Face Split projector (§3.4 C: 5)
+    /// and the point-cloud samples.
+    pub sdf_projection_steps: usize,
+    /// The Face Split block of an SDF input projects its samples onto the field (§3.4 C, 6
+    /// gradient evaluations per sample) rather than by the k-NN planar projection over the point
+    /// cloud. The spec's choice and on by default; with a neural field it is most of the run's
+    /// evaluations (`docs/sdf.md`, "Measured cost").
+    pub sdf_split_projector: bool,
+    /// A projected sample of an SDF input is valid when its first-order distance `|f|/|∇f|` ends
+    /// at most this, in rig units (§3.4 C: 1e-6 for float64 fields; f32 networks need more).
+    pub sdf_projection_tolerance: f64,
 }
 
 impl Default for ReconstructConfig {
@@ -240,11 +265,30 @@ impl Default for ReconstructConfig {
             sliver_quality: 10.0,
             best_effort: false,
             keep_topology: false,
+            sdf_loss_weight: 0.1,
+            sdf_loss_start: 500,
+            sdf_loss_epsilon: 1e-10,
+            sdf_init_resolution: 64,
+            sdf_trace_grid: 128,
+            sdf_trace_refine_steps: 8,
+            sdf_projection_steps: 5,
+            sdf_split_projector: true,
+            sdf_projection_tolerance: 1e-5,
         }
     }
 }
 
 impl ReconstructConfig {
+    /// The SDF schedule of spec §5, the defaults for signed distance inputs: the full pipeline
+    /// with 700 iterations and 50k faces, the SDF loss on from iteration 500.
+    pub fn sdf_defaults() -> Self {
+        Self {
+            faces: 50_000,
+            iterations: 700,
+            ..Self::default()
+        }
+    }
+
     /// W = clamp(factor·N, min, max), never below N (DESIGN.md §2).
     pub fn working_budget(&self) -> usize {
         let w = (self.working_budget_factor * self.faces)
@@ -374,6 +418,26 @@ impl ReconstructConfig {
                 self.polish_iterations as f64,
             ),
             (off("sliver_quality", 1.0, 1e6), self.sliver_quality),
+            (r("sdf_loss_weight", 0.0, 1e6), self.sdf_loss_weight),
+            (r("sdf_loss_start", 0.0, 1e5), self.sdf_loss_start as f64),
+            (r("sdf_loss_epsilon", 0.0, 1.0), self.sdf_loss_epsilon),
+            (
+                r("sdf_init_resolution", 2.0, 1024.0),
+                self.sdf_init_resolution as f64,
+            ),
+            (r("sdf_trace_grid", 2.0, 2048.0), self.sdf_trace_grid as f64),
+            (
+                r("sdf_trace_refine_steps", 0.0, 100.0),
+                self.sdf_trace_refine_steps as f64,
+            ),
+            (
+                r("sdf_projection_steps", 1.0, 100.0),
+                self.sdf_projection_steps as f64,
+            ),
+            (
+                r("sdf_projection_tolerance", 1e-12, 1.0),
+                self.sdf_projection_tolerance,
+            ),
         ]
     }
 }

@@ -33,6 +33,7 @@ pub(super) fn finish(
     run: &mut Run,
 ) -> Result<Mesh, PipelineError> {
     let config = run.config;
+    loss.set_iteration(config.iterations);
     let faces = states.last().map_or(0, |state| state.mesh.n_faces());
     run.report("finish", config.iterations, run.stats.loss_last, faces)?;
     let mut mesh = finish_from_best_state(states, config, &mut run.stats)?;

@@ -21,6 +21,7 @@ mod finish;
 mod init;
 mod optimize;
 mod prepare;
+pub mod sdf;
 pub mod soup;
 
 use std::collections::BTreeMap;
@@ -30,8 +31,8 @@ use std::time::Instant;
 
 use glam::DVec3;
 use roar_loss::{
-    KnnOptions, Loss, LossError, PlanarLoss, PlanarOptions, PointCloud, RenderLoss, Shape,
-    ShapeError, SignedDistance, TargetOptions, WeightedSum,
+    KnnOptions, Loss, LossError, PlanarLoss, PlanarOptions, PointCloud, RenderLoss, Sdf, SdfLoss,
+    SdfLossOptions, Shape, ShapeError, TargetOptions, WeightedSum,
 };
 use roar_mesh::spatial::Projector;
 use roar_ops::blocks::block::Block;
@@ -46,6 +47,7 @@ use roar_render::{Camera, Image, star_cameras};
 use serde::Serialize;
 
 pub use config::{InitKind, ReconstructConfig};
+pub use sdf::SdfShape;
 pub use soup::SoupShape;
 
 /// Why a reconstruction failed.
@@ -90,7 +92,7 @@ pub struct Prepared<'a> {
     /// The oriented target point cloud P (with the sharp-edge samples).
     pub cloud: &'a PointCloud,
     /// The shape's signed distance, if it has one.
-    pub signed_distance: Option<&'a dyn SignedDistance>,
+    pub signed_distance: Option<Arc<dyn Sdf>>,
     /// The effective configuration.
     pub config: &'a ReconstructConfig,
 }
@@ -352,7 +354,8 @@ pub fn planar_options(config: &ReconstructConfig) -> PlanarOptions {
     }
 }
 
-/// The default objective: `λ1·L_render + λ2·L_planar` (spec §3.2.3).
+/// The default objective: `λ1·L_render + λ2·L_planar` (spec §3.2.3), plus
+/// `sdf_loss_weight·L_sdf` (spec §5) when the shape has a signed distance.
 pub fn default_loss(prepared: &Prepared) -> Result<Box<dyn Loss>, PipelineError> {
     let config = prepared.config;
     let planar = PlanarLoss::new(
@@ -360,14 +363,23 @@ pub fn default_loss(prepared: &Prepared) -> Result<Box<dyn Loss>, PipelineError>
         &prepared.cloud.normals,
         &planar_options(config),
     )?;
-    Ok(Box::new(
-        WeightedSum::default()
-            .with(
-                config.render_weight,
-                Box::new(RenderLoss::from_renders(prepared.cameras, prepared.renders)),
-            )
-            .with(config.planar_weight, Box::new(planar)),
-    ))
+    let mut sum = WeightedSum::default()
+        .with(
+            config.render_weight,
+            Box::new(RenderLoss::from_renders(prepared.cameras, prepared.renders)),
+        )
+        .with(config.planar_weight, Box::new(planar));
+    if let Some(sdf) = &prepared.signed_distance {
+        let options = SdfLossOptions {
+            start_iteration: config.sdf_loss_start,
+            epsilon: config.sdf_loss_epsilon,
+        };
+        sum = sum.with(
+            config.sdf_loss_weight,
+            Box::new(SdfLoss::new(sdf.clone(), options)),
+        );
+    }
+    Ok(Box::new(sum))
 }
 
 /// The paper's schedule (spec §1.2, §1.3).

@@ -82,6 +82,7 @@ pub(super) fn optimize(
         let candidate = (config.checkpoint_interval > 0
             && iteration % config.checkpoint_interval == 0)
             .then(|| mesh.clone());
+        loss.set_iteration(iteration);
         let record = move_vertices(
             &mut mesh,
             &mut optimizer,

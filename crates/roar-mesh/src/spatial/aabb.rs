@@ -112,6 +112,25 @@ impl Aabb {
             && p.z <= self.max.z
     }
 
+    /// The parameters `[t_in, t_out]` (with `t_in ≥ 0`) where the ray `origin + t·dir` is inside
+    /// the closed box, or `None` when it misses it.
+    pub fn ray_interval(&self, origin: DVec3, dir: DVec3) -> Option<(f64, f64)> {
+        let (mut t_in, mut t_out) = (0.0_f64, f64::INFINITY);
+        for axis in 0..3 {
+            let (o, d) = (origin[axis], dir[axis]);
+            if d == 0.0 {
+                if o < self.min[axis] || o > self.max[axis] {
+                    return None;
+                }
+                continue;
+            }
+            let (a, b) = ((self.min[axis] - o) / d, (self.max[axis] - o) / d);
+            t_in = t_in.max(a.min(b));
+            t_out = t_out.min(a.max(b));
+        }
+        (t_in <= t_out).then_some((t_in, t_out))
+    }
+
     /// Squared distance from `p` to the box (0 inside).
     pub fn distance_squared(&self, p: DVec3) -> f64 {
         let d = (self.min - p).max(p - self.max).max(DVec3::ZERO);

@@ -14,7 +14,8 @@
 //! (area-weighted random samples),
 //! [`winding`] (fast winding numbers), [`regular_sampling`] (regular per-face grids),
 //! [`projector`] (the `Projector` trait), [`ray_projector`] (exact ray-cast projection, §3.4 (B)),
-//! [`vertex_normals`](mod@vertex_normals) (the ROAR vertex normals, §2.2).
+//! [`vertex_normals`](mod@vertex_normals) (the ROAR vertex normals, §2.2), [`sdf`] (the `Sdf` trait
+//! of signed distance inputs).
 
 pub mod aabb;
 pub mod bvh;
@@ -24,6 +25,7 @@ pub mod projector;
 pub mod ray_projector;
 pub mod regular_sampling;
 pub mod sampling;
+pub mod sdf;
 pub mod self_intersections;
 pub mod tri_tri;
 pub mod vertex_normals;
@@ -40,6 +42,10 @@ pub use regular_sampling::{
     grid_point_count, regular_sample_points, regular_sample_points_into, regular_samples,
 };
 pub use sampling::{SurfaceSamples, sample_surface};
+pub use sdf::{
+    FnSdf, Sdf, SdfCounter, SdfEvaluations, evaluate_with_gradients, first_order_step,
+    project_to_zero_set,
+};
 pub use self_intersections::{
     count_intersecting_faces, face_intersects_any, intersecting_pairs, self_intersecting_faces,
 };

@@ -36,7 +36,7 @@ pub use initial::{InitialMeshOptions, InitialMeshStats, initial_mesh, initial_me
 
 use glam::DVec3;
 use grid::{Grid, SOLID};
-use roar_mesh::spatial::TriangleBvh;
+use roar_mesh::spatial::{Sdf, TriangleBvh};
 use thiserror::Error;
 
 /// Options of [`watertight_init`]. Lengths are in voxels.
@@ -478,9 +478,10 @@ fn watertight_init_from(
 /// Builds a closed, outward-oriented 2-manifold from the cells of a grid over
 /// `[bounds_min, bounds_max]` whose centre has `sdf < 0` (spec §4.3), with the same manifold repair
 /// and boundary extraction as [`watertight_init`]. Interior voids are filled (the exterior is the
-/// region connected to the border). Vertices stay on the grid corners.
+/// region connected to the border). Vertices stay on the grid corners. The cell centres are
+/// evaluated in one batch of values ([`Sdf::values`]; no gradients); a NaN counts as outside.
 pub fn sdf_init(
-    sdf: &dyn Fn(DVec3) -> f64,
+    sdf: &dyn Sdf,
     bounds_min: DVec3,
     bounds_max: DVec3,
     options: &SdfInitOptions,
@@ -498,14 +499,21 @@ pub fn sdf_init(
     }
     let padding = 2;
     let grid = Grid::around(bounds_min, bounds_max, options.resolution, padding);
+    let interior: Vec<usize> = (0..grid.len())
+        .filter(|&idx| {
+            let c = grid.coords(idx);
+            (0..3).all(|a| c[a] >= padding && c[a] + padding < grid.dims[a])
+        })
+        .collect();
+    let centers: Vec<DVec3> = interior
+        .iter()
+        .map(|&idx| grid.corner(grid.coords(idx)) + DVec3::splat(0.5 * grid.voxel_size))
+        .collect();
+    let mut values = vec![0.0; centers.len()];
+    sdf.values(&centers, &mut values);
     let mut inside = vec![0u8; grid.len()];
-    for (idx, cell) in inside.iter_mut().enumerate() {
-        let c = grid.coords(idx);
-        let interior = (0..3).all(|a| c[a] >= padding && c[a] + padding < grid.dims[a]);
-        if interior {
-            let center = grid.corner(c) + DVec3::splat(0.5 * grid.voxel_size);
-            *cell = u8::from(sdf(center) < 0.0);
-        }
+    for (&idx, &f) in interior.iter().zip(&values) {
+        inside[idx] = u8::from(f < 0.0);
     }
     let mut state = solid::flood_exterior(&grid, &inside);
     let repair = solid::repair_nonmanifold(&grid, &mut state, options.max_repair_passes).ok_or(

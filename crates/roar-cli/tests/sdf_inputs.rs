@@ -1,0 +1,229 @@
+//! SDF inputs through the CLI and the pipeline: the SDF schedule's defaults, one-line errors
+//! for bad files with no output, and (release, run by `.ci/run` with `--ignored`) reduced
+//! reconstructions of analytic shapes and of the two shared neural SDFs, each a closed,
+//! oriented 2-manifold with exactly the budget, no self-intersecting faces and its vertices near
+//! the zero set.
+
+mod common;
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+use std::sync::Arc;
+
+use glam::DVec3;
+use roar_cli::pipeline::sdf::DEFAULT_BOUNDS;
+use roar_cli::pipeline::{ReconstructConfig, Reconstruction, SdfShape};
+use roar_mesh::Mesh;
+use roar_mesh::spatial::{Aabb, Sdf, evaluate_with_gradients, self_intersecting_faces};
+use roar_sdf::{AnalyticSdf, load_sdf};
+
+fn roar(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_roar"))
+        .args(args)
+        .output()
+        .expect("roar runs")
+}
+
+#[test]
+fn print_config_of_an_sdf_input_gives_the_sdf_schedule() {
+    let dir = tempfile::tempdir().unwrap();
+    let shape = dir.path().join("ball.sdf.toml");
+    std::fs::write(&shape, "[shape]\ntype = \"sphere\"\nradius = 0.5\n").unwrap();
+    let out = roar(&["reconstruct", shape.to_str().unwrap(), "--print-config"]);
+    assert!(out.status.success());
+    let config: ReconstructConfig = toml::from_str(&String::from_utf8_lossy(&out.stdout)).unwrap();
+    assert_eq!(config, ReconstructConfig::sdf_defaults());
+    assert_eq!((config.iterations, config.faces), (700, 50_000));
+    assert_eq!((config.sdf_loss_weight, config.sdf_loss_start), (0.1, 500));
+    // A config file's keys go over the SDF defaults, not the soup's.
+    let file = dir.path().join("c.toml");
+    std::fs::write(&file, "faces = 1000\n").unwrap();
+    let out = roar(&[
+        "reconstruct",
+        shape.to_str().unwrap(),
+        "--print-config",
+        "--config",
+    ])
+    .status;
+    assert!(!out.success(), "--config needs a value");
+    let out = roar(&[
+        "reconstruct",
+        shape.to_str().unwrap(),
+        "--print-config",
+        "--config",
+        file.to_str().unwrap(),
+    ]);
+    let config: ReconstructConfig = toml::from_str(&String::from_utf8_lossy(&out.stdout)).unwrap();
+    assert_eq!((config.iterations, config.faces), (700, 1000));
+}
+
+#[test]
+fn bad_sdf_files_fail_in_one_line_and_write_nothing() {
+    let dir = tempfile::tempdir().unwrap();
+    let cases: [(&str, &[u8], &str); 3] = [
+        (
+            "cone.sdf.toml",
+            b"[shape]\ntype = \"cone\"\n",
+            "unknown type 'cone'",
+        ),
+        ("junk.npz", b"PK\x03\x04 truncated", "npz"),
+        ("empty.npz", b"", "npz"),
+    ];
+    for (name, bytes, expected) in cases {
+        let input = dir.path().join(name);
+        std::fs::write(&input, bytes).unwrap();
+        let output = dir.path().join("out.obj");
+        let out = roar(&[
+            "reconstruct",
+            input.to_str().unwrap(),
+            "-o",
+            output.to_str().unwrap(),
+            "--faces",
+            "200",
+            "-q",
+        ]);
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(!out.status.success(), "{name}");
+        assert!(stderr.contains(expected), "{name}: {stderr}");
+        assert_eq!(stderr.trim().lines().count(), 1, "{name}: {stderr}");
+        assert!(!output.exists(), "{name}: wrote an output");
+    }
+    let out = roar(&[
+        "reconstruct",
+        "x.sdf.toml",
+        "-o",
+        "o.obj",
+        "--bounds",
+        "0,0,0,1,1",
+    ]);
+    assert!(String::from_utf8_lossy(&out.stderr).contains("six numbers"));
+}
+
+/// Toy settings for an SDF input at `faces`, with the SDF loss on for the second half; the Face
+/// Split block projects onto the field when `split_projector` (costly on a network: about 6
+/// gradient evaluations per sample of every face, every `split_interval` iterations).
+fn toy_sdf_config(faces: usize, split_projector: bool) -> ReconstructConfig {
+    let iterations = 30;
+    ReconstructConfig {
+        sdf_loss_start: iterations / 2,
+        sdf_split_projector: split_projector,
+        sdf_trace_grid: 64,
+        ..common::toy_config(faces, iterations)
+    }
+}
+
+/// What a reduced run gives: checked closed, exact, intersection-free; returns the mesh and
+/// the mean, 99th percentile and largest first-order distance `|f|/|∇f|` of its vertices from
+/// the zero set.
+fn reconstruct(
+    field: Arc<dyn Sdf>,
+    bounds: Aabb,
+    faces: usize,
+    split_projector: bool,
+) -> (Mesh, [f64; 3]) {
+    let config = toy_sdf_config(faces, split_projector);
+    let mut shape = SdfShape::new("test", field.clone(), bounds, &config);
+    let out = Reconstruction::new(config)
+        .run(&mut shape, &mut |_| {})
+        .unwrap();
+    assert_eq!(out.triangles.len(), faces);
+    let intersecting = self_intersecting_faces(&out.positions, &out.triangles);
+    assert!(!intersecting.contains(&true), "self-intersecting faces");
+    let mesh = Mesh::from_triangles(out.positions.clone(), &out.triangles)
+        .expect("a closed, oriented 2-manifold");
+    let (values, gradients) = evaluate_with_gradients(field.as_ref(), &out.positions);
+    let mut distances: Vec<f64> = values
+        .iter()
+        .zip(&gradients)
+        .map(|(f, g)| f.abs() / g.length())
+        .collect();
+    distances.sort_by(f64::total_cmp);
+    let mean = distances.iter().sum::<f64>() / distances.len() as f64;
+    let p99 = distances[distances.len() * 99 / 100];
+    let max = distances[distances.len() - 1];
+    let report = shape.report();
+    println!(
+        "{faces} faces: genus {}, zero-set distance mean {mean:.2e} p99 {p99:.2e} max {max:.2e}; \
+         evaluations {:?} {:?}; trace {:.2} s",
+        mesh.genus(),
+        report.values,
+        report.gradients,
+        report.trace_seconds
+    );
+    (mesh, [mean, p99, max])
+}
+
+#[test]
+#[ignore = "release: reduced SDF reconstructions (run by .ci/run)"]
+fn analytic_box_minus_cylinder_has_genus_one_and_a_sphere_is_within_one_percent() {
+    let drilled = AnalyticSdf::from_toml(
+        r#"
+[shape]
+type = "difference"
+[[shape.children]]
+type = "box"
+half_extents = [0.6, 0.6, 0.35]
+[[shape.children]]
+type = "cylinder"
+radius = 0.25
+half_height = 1.0
+"#,
+    )
+    .unwrap();
+    let (mesh, _) = reconstruct(Arc::new(drilled), DEFAULT_BOUNDS, 2000, true);
+    assert_eq!(mesh.genus(), 1);
+
+    let radius = 0.7;
+    let sphere = AnalyticSdf::from_toml(&format!(
+        "[shape]\ntype = \"sphere\"\nradius = {radius}\ntranslate = [0.3, -0.2, 0.1]\n"
+    ))
+    .unwrap();
+    let bounds = Aabb {
+        min: DVec3::new(-0.6, -1.0, -0.7),
+        max: DVec3::new(1.1, 0.6, 0.9),
+    };
+    let (mesh, [_, _, max]) = reconstruct(Arc::new(sphere), bounds, 1000, true);
+    assert_eq!(mesh.genus(), 0);
+    let diagonal = 2.0 * radius * 3f64.sqrt();
+    assert!(
+        max < 0.01 * diagonal,
+        "farthest vertex {max} off the sphere"
+    );
+}
+
+/// The shared neural SDFs, or `None` (with a note) outside CI when `ROAR_SDF_DATA` is unset.
+fn sdf_data() -> Option<PathBuf> {
+    let Some(root) = std::env::var_os("ROAR_SDF_DATA") else {
+        assert!(
+            std::env::var_os("CI").is_none(),
+            "ROAR_SDF_DATA must be set under CI"
+        );
+        eprintln!("ROAR_SDF_DATA is unset: skipping the shared neural SDFs");
+        return None;
+    };
+    Some(PathBuf::from(root))
+}
+
+#[test]
+#[ignore = "release: reduced reconstructions of the shared neural SDFs (run by .ci/run)"]
+fn shared_neural_sdfs_reconstruct_closed_exact_and_near_their_zero_sets() {
+    let Some(root) = sdf_data() else { return };
+    for name in ["nif-bunny.npz", "nif-hammer.npz"] {
+        let field = load_sdf(&Path::new(&root).join(name)).unwrap();
+        let (mesh, [mean, p99, max]) = reconstruct(field, DEFAULT_BOUNDS, 2000, false);
+        assert_eq!(mesh.genus(), 0, "{name}: its zero set has genus 0");
+        // Against the bounds' diagonal (3.8). Measured with these toy settings: mean 1.0e-3
+        // (bunny) and 7.2e-4 (hammer) of it, 99th percentile 4.2e-3 and 3.9e-3; the largest,
+        // 2.5e-2 on the hammer, is a vertex of a thin part that the toy run's coarse renders
+        // and few iterations leave off the surface.
+        let diagonal = DEFAULT_BOUNDS.diagonal();
+        println!(
+            "{name}: mean {:.2e} p99 {:.2e} max {:.2e} of the diagonal",
+            mean / diagonal,
+            p99 / diagonal,
+            max / diagonal
+        );
+        assert!(mean < 2e-3 * diagonal, "{name}: mean {mean}");
+        assert!(p99 < 1e-2 * diagonal, "{name}: 99th percentile {p99}");
+    }
+}
