@@ -13,12 +13,16 @@ use roar_eval::{EvalOptions, Report};
 use serde::Serialize;
 
 use crate::checks::check_paths;
-use crate::pipeline::{InitKind, Progress, ReconstructConfig, Reconstruction, RunStats, SoupShape};
+use crate::pipeline::{
+    InitKind, Progress, ReconstructConfig, Reconstruction, RunStats, ScanReport, ScanShape,
+    SoupShape, load_scans,
+};
 
 /// Arguments of `roar reconstruct`.
 #[derive(Args, Debug)]
 pub struct ReconstructArgs {
-    /// Any triangle soup (OBJ, PLY, STL or OFF).
+    /// Any triangle soup (OBJ, PLY, STL or OFF; a PLY range image is its patch), or a set of
+    /// range scans: a Stanford `.conf` or the folder holding one.
     pub input: Option<PathBuf>,
     /// Where to write the result (format by extension).
     #[arg(short, long)]
@@ -47,6 +51,9 @@ pub struct ReconstructArgs {
     /// Keep the genus: fail when the budget is too small for it instead of removing handles.
     #[arg(long)]
     pub keep_topology: bool,
+    /// Range scans: keep the `.conf` poses (no ICP).
+    #[arg(long)]
+    pub no_icp: bool,
     /// Also write the JSON report to this file.
     #[arg(long)]
     pub report: Option<PathBuf>,
@@ -84,6 +91,9 @@ pub struct ReconstructReport {
     pub run: RunStats,
     /// The effective configuration.
     pub config: ReconstructConfig,
+    /// Range scans: each scan's patch and alignment (absent for other inputs).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub scans: Option<Vec<ScanReport>>,
 }
 
 /// Runs `roar reconstruct`.
@@ -119,7 +129,15 @@ pub fn run(args: &ReconstructArgs) -> anyhow::Result<()> {
     check_paths(&inputs, &outputs)?;
     roar_io::MeshFormat::for_writing(output)?;
     let started = Instant::now();
-    let soup = roar_io::read_mesh(input)?;
+    let scans = if roar_io::is_scan_set(input) {
+        Some(load_scans(input, &config, config.scan_icp)?)
+    } else {
+        None
+    };
+    let soup = match &scans {
+        Some(scans) => scans.union(),
+        None => roar_io::read_mesh(input)?,
+    };
     check_resources(&config, soup.triangles.len(), args.force)?;
 
     let bar = progress_bar(args.quiet, config.iterations);
@@ -135,18 +153,20 @@ pub fn run(args: &ReconstructArgs) -> anyhow::Result<()> {
             });
         }
     };
-    // Every input `roar reconstruct` reads today is a triangle soup.
     let name = input.file_name().map_or_else(
         || input.display().to_string(),
         |n| n.to_string_lossy().into_owned(),
     );
-    let mut shape = SoupShape::new(name, &soup.positions, &soup.triangles, &config);
     let mut reconstruction = Reconstruction::new(config.clone());
-    let result = reconstruction
-        .run(&mut shape, &mut on_progress)
-        .with_context(|| format!("{}: reconstruction failed", input.display()));
-    // The prepared target and its renders are not needed for the report.
-    drop(shape);
+    // The shape (its prepared target and renders) lives only as long as the run.
+    let result = if scans.is_some() {
+        let mut shape = ScanShape::new(name, &soup.positions, &soup.triangles, &config);
+        reconstruction.run(&mut shape, &mut on_progress)
+    } else {
+        let mut shape = SoupShape::new(name, &soup.positions, &soup.triangles, &config);
+        reconstruction.run(&mut shape, &mut on_progress)
+    }
+    .with_context(|| format!("{}: reconstruction failed", input.display()));
     if let Some(bar) = &bar {
         bar.finish_and_clear();
     }
@@ -174,7 +194,14 @@ pub fn run(args: &ReconstructArgs) -> anyhow::Result<()> {
         output_metrics,
         run: result.stats,
         config,
+        scans: scans.map(|s| s.reports),
     };
+    for scan in report.scans.iter().flatten().filter(|s| !s.overlaps) {
+        eprintln!(
+            "note: {} overlaps too little of the other scans for ICP; it keeps its .conf pose",
+            scan.file
+        );
+    }
     for failure in &report.run.untangle_failures {
         eprintln!(
             "note: {} faces of the loop's state at iteration {} could not be untangled; tried the \
@@ -238,6 +265,9 @@ pub fn effective_config(args: &ReconstructArgs) -> anyhow::Result<ReconstructCon
         } else {
             InitKind::Watertight
         };
+    }
+    if args.no_icp {
+        config.scan_icp = false;
     }
     if let Some(iterations) = args.iterations {
         config.iterations = iterations;

@@ -10,7 +10,7 @@
 //!   → smoothing → data flips → polish → denormalize
 //! ```
 //!
-//! The input is any [`Shape`] (the soup is [`SoupShape`]): the pipeline asks it for its
+//! The input is any [`Shape`] (the soup is [`SoupShape`], a set of range scans [`ScanShape`]): the pipeline asks it for its
 //! normalization, target renders, point cloud and initial mesh, and never which kind it is.
 //! A researcher swaps a piece without forking a crate: [`Reconstruction::loss_factory`] builds
 //! the objective from what the shape gave, and [`Reconstruction::blocks`] is the remeshing
@@ -21,6 +21,7 @@ mod finish;
 mod init;
 mod optimize;
 mod prepare;
+pub mod scans;
 pub mod soup;
 
 use std::collections::BTreeMap;
@@ -46,6 +47,7 @@ use roar_render::{Camera, Image, star_cameras};
 use serde::Serialize;
 
 pub use config::{InitKind, ReconstructConfig};
+pub use scans::{AlignedScans, ScanReport, ScanShape, load_scans};
 pub use soup::SoupShape;
 
 /// Why a reconstruction failed.
