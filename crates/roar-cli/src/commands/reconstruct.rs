@@ -244,18 +244,21 @@ pub fn run(args: &ReconstructArgs) -> anyhow::Result<()> {
     Ok(())
 }
 
+/// The defaults overridden by the TOML file at `path`, if any; a parse error is one line naming
+/// the file.
+pub fn read_config(path: Option<&std::path::Path>) -> anyhow::Result<ReconstructConfig> {
+    let Some(path) = path else {
+        return Ok(ReconstructConfig::default());
+    };
+    let text =
+        std::fs::read_to_string(path).with_context(|| format!("cannot read {}", path.display()))?;
+    toml::from_str(&text)
+        .map_err(|e| anyhow::anyhow!("{}: {}", path.display(), e.to_string().replace('\n', " ")))
+}
+
 /// Defaults, then the TOML file, then the flags.
 pub fn effective_config(args: &ReconstructArgs) -> anyhow::Result<ReconstructConfig> {
-    let mut config = match &args.config {
-        Some(path) => {
-            let text = std::fs::read_to_string(path)
-                .with_context(|| format!("cannot read {}", path.display()))?;
-            toml::from_str(&text).map_err(|e| {
-                anyhow::anyhow!("{}: {}", path.display(), e.to_string().replace('\n', " "))
-            })?
-        }
-        None => ReconstructConfig::default(),
-    };
+    let mut config = read_config(args.config.as_deref())?;
     if let Some(faces) = args.faces {
         config.faces = faces;
     }

@@ -4,11 +4,10 @@
 
 use std::path::PathBuf;
 
-use anyhow::Context;
 use clap::Args;
 
 use crate::checks::check_paths;
-use crate::pipeline::{ReconstructConfig, load_scans};
+use crate::pipeline::load_scans;
 
 /// Arguments of `roar scans`.
 #[derive(Args, Debug)]
@@ -36,16 +35,7 @@ pub fn run(args: &ScansArgs) -> anyhow::Result<()> {
     inputs.extend(args.config.as_deref().map(|c| ("--config", c)));
     check_paths(&inputs, &[("-o", &args.output)])?;
     roar_io::MeshFormat::for_writing(&args.output)?;
-    let config = match &args.config {
-        Some(path) => {
-            let text = std::fs::read_to_string(path)
-                .with_context(|| format!("cannot read {}", path.display()))?;
-            toml::from_str(&text).map_err(|e| {
-                anyhow::anyhow!("{}: {}", path.display(), e.to_string().replace('\n', " "))
-            })?
-        }
-        None => ReconstructConfig::default(),
-    };
+    let config = crate::commands::reconstruct::read_config(args.config.as_deref())?;
     config
         .validate()
         .map_err(|e| anyhow::anyhow!("config: {e}"))?;
