@@ -47,7 +47,9 @@ use roar_render::{Camera, Image, star_cameras};
 use serde::Serialize;
 
 pub use config::{InitKind, ReconstructConfig};
-pub use scans::{AlignedScans, ScanReport, ScanShape, load_scans};
+pub use scans::{
+    AlignedScans, SCAN_ENCLOSURE_WINDING_THRESHOLD, ScanReport, ScanShape, load_scans,
+};
 pub use soup::SoupShape;
 
 /// Why a reconstruction failed.
