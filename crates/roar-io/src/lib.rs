@@ -36,6 +36,7 @@ mod image_dump;
 mod obj;
 mod off;
 mod ply;
+mod point_scan;
 mod polygon;
 mod range_grid;
 mod scan_set;
@@ -55,9 +56,12 @@ pub use image_dump::{write_exr_rgba, write_png_rgba8};
 pub use obj::{read_obj, write_obj};
 pub use off::{read_off, write_off};
 pub use ply::{PlyEncoding, read_ply, read_range_grid, write_ply};
+pub use point_scan::point_scan_patch;
 pub use polygon::{MAX_EAR_CLIPPING_CORNERS, PLANARITY_TOLERANCE, triangulate_polygon};
 pub use range_grid::{PatchOptions, PatchStats, RangeGrid, SCANNER_VIEW};
-pub use scan_set::{ScanPose, ScanSet, is_scan_set, read_range_grid_file, read_scan_set};
+pub use scan_set::{
+    ScanPose, ScanSet, is_scan_set, read_range_grid_file, read_scan_patch_file, read_scan_set,
+};
 pub use soup::{SoupDefect, TriangleSoup};
 pub use stl::{StlEncoding, read_stl, write_stl};
 

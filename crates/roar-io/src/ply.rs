@@ -11,7 +11,8 @@
 //! lists holding no index or one vertex index, row-major, the Stanford scans' layout) is read
 //! by [`read_range_grid`]; [`read_ply`] turns a file with a range grid and no faces into its
 //! patch ([`crate::RangeGrid::patch`] with default options), so one scan is accepted anywhere a
-//! mesh is.
+//! mesh is; a file of points alone is an unorganised scan, read as its Delaunay patch
+//! ([`crate::point_scan_patch`]).
 //!
 //! The writers emit `double x, y, z` and `list uchar uint vertex_indices`: binary output
 //! round-trips f64 bit for bit, and so does ASCII (shortest round-trip formatting).
@@ -160,7 +161,18 @@ pub fn read_ply(bytes: &[u8], file: &str) -> Result<TriangleSoup, IoError> {
             });
         }
         (None, Some(grid)) => grid,
-        (None, None) => return Err(IoError::in_file(file, "mesh has no faces")),
+        (None, None) => {
+            let (patch, _) =
+                crate::point_scan_patch(&body.positions, &crate::PatchOptions::default());
+            if patch.triangles.is_empty() {
+                return Err(IoError::in_file(
+                    file,
+                    "PLY file has no faces and no range grid, and its points give no triangle \
+                     as an unorganised scan",
+                ));
+            }
+            return Ok(patch);
+        }
     };
     let grid = crate::RangeGrid {
         cols,
@@ -195,6 +207,30 @@ pub fn read_range_grid(bytes: &[u8], file: &str) -> Result<crate::RangeGrid, IoE
         positions: body.positions,
         cells,
     })
+}
+
+/// A scan's patch from a PLY file: its range grid's ([`crate::RangeGrid::patch`]) or, for points
+/// alone, the unorganised scan's ([`crate::point_scan_patch`]); a file with faces is not a scan.
+pub(crate) fn read_scan_patch(
+    bytes: &[u8],
+    file: &str,
+    options: &crate::PatchOptions,
+) -> Result<(TriangleSoup, crate::PatchStats), IoError> {
+    let body = read_ply_body(bytes, file)?;
+    match (body.faces, body.grid) {
+        (Some(_), _) => Err(IoError::in_file(
+            file,
+            "a scan is a range grid or points alone, but this PLY file has faces",
+        )),
+        (None, Some((cells, [cols, rows]))) => Ok(crate::RangeGrid {
+            cols,
+            rows,
+            positions: body.positions,
+            cells,
+        }
+        .patch(options)),
+        (None, None) => Ok(crate::point_scan_patch(&body.positions, options)),
+    }
 }
 
 fn read_ply_body(bytes: &[u8], file: &str) -> Result<PlyBody, IoError> {
@@ -513,9 +549,8 @@ fn read_body(
             grid_dims = Some([cols, rows]);
             (grid, Role::Grid(list))
         }
-        (None, None) => {
-            return Err(IoError::in_file(file, "PLY header has no 'face' element"));
-        }
+        // Points alone: an unorganised scan, read with no list element.
+        (None, None) => (vertex, Role::Skip),
     };
     let mut xyz = [usize::MAX; 3];
     for (k, axis) in ["x", "y", "z"].iter().enumerate() {
@@ -639,6 +674,11 @@ fn read_body(
             positions,
             faces: None,
             grid: Some((cells, dims)),
+        }),
+        None if face.is_none() => Ok(PlyBody {
+            positions,
+            faces: None,
+            grid: None,
         }),
         None => {
             if fans.is_empty() {

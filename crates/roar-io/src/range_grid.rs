@@ -67,6 +67,37 @@ pub struct PatchStats {
     pub dropped_grazing: usize,
 }
 
+/// The triangle `t` of `positions` oriented toward the scanner, or `None` (counted in `stats`)
+/// when an edge is longer than `options.max_edge_factor × local` or its normal is more than
+/// `options.max_angle_degrees` from `toward_scanner`. Shared by grids and unorganised scans.
+pub(crate) fn keep_facing_scanner(
+    positions: &[DVec3],
+    t: [u32; 3],
+    local: f64,
+    toward_scanner: DVec3,
+    options: &PatchOptions,
+    stats: &mut PatchStats,
+) -> Option<[u32; 3]> {
+    let [p0, p1, p2] = t.map(|i| positions[i as usize]);
+    let longest = p0.distance(p1).max(p1.distance(p2)).max(p2.distance(p0));
+    if longest > options.max_edge_factor * local {
+        stats.dropped_long_edge += 1;
+        return None;
+    }
+    let normal = (p1 - p0).cross(p2 - p0);
+    let length = normal.length();
+    let cosine = if length > 0.0 {
+        normal.dot(toward_scanner) / length
+    } else {
+        0.0
+    };
+    if length == 0.0 || cosine.abs() < options.max_angle_degrees.to_radians().cos() {
+        stats.dropped_grazing += 1;
+        return None;
+    }
+    Some(if cosine > 0.0 { t } else { [t[0], t[2], t[1]] })
+}
+
 /// Radius (in cells) of the window whose grid-neighbour distances give the local spacing.
 const SPACING_WINDOW: usize = 2;
 
@@ -86,7 +117,6 @@ impl RangeGrid {
     /// counter-clockwise seen from the scanner (normals toward it).
     pub fn patch(&self, options: &PatchOptions) -> (TriangleSoup, PatchStats) {
         let spacing = self.local_spacing();
-        let cos_max = options.max_angle_degrees.to_radians().cos();
         let toward_scanner = -SCANNER_VIEW;
         let mut stats = PatchStats::default();
         let mut triangles = Vec::new();
@@ -119,24 +149,16 @@ impl RangeGrid {
                 let local = spacing[r * cells_x + c];
                 for t in candidates.into_iter().flatten() {
                     stats.candidates += 1;
-                    let [p0, p1, p2] = t.map(|i| self.positions[i as usize]);
-                    let longest = p0.distance(p1).max(p1.distance(p2)).max(p2.distance(p0));
-                    if longest > options.max_edge_factor * local {
-                        stats.dropped_long_edge += 1;
-                        continue;
+                    if let Some(t) = keep_facing_scanner(
+                        &self.positions,
+                        t,
+                        local,
+                        toward_scanner,
+                        options,
+                        &mut stats,
+                    ) {
+                        triangles.push(t);
                     }
-                    let normal = (p1 - p0).cross(p2 - p0);
-                    let length = normal.length();
-                    let cosine = if length > 0.0 {
-                        normal.dot(toward_scanner) / length
-                    } else {
-                        0.0
-                    };
-                    if cosine.abs() < cos_max || length == 0.0 {
-                        stats.dropped_grazing += 1;
-                        continue;
-                    }
-                    triangles.push(if cosine > 0.0 { t } else { [t[0], t[2], t[1]] });
                 }
             }
         }

@@ -156,6 +156,20 @@ fn find_conf(folder: &Path) -> Result<PathBuf, IoError> {
     }
 }
 
+/// Reads a scan from a PLY file, a range image or points alone, and makes its patch with
+/// `options` ([`crate::RangeGrid::patch`], [`crate::point_scan_patch`]). Errors: those of the
+/// PLY reader, and a PLY file with faces (not a scan).
+pub fn read_scan_patch_file(
+    path: &Path,
+    options: &crate::PatchOptions,
+) -> Result<(crate::TriangleSoup, crate::PatchStats), IoError> {
+    let bytes = std::fs::read(path).map_err(|source| IoError::Os {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    crate::ply::read_scan_patch(&bytes, &path.display().to_string(), options)
+}
+
 /// Reads a range image from a PLY file ([`crate::read_range_grid`] on its bytes).
 pub fn read_range_grid_file(path: &Path) -> Result<RangeGrid, IoError> {
     let bytes = std::fs::read(path).map_err(|source| IoError::Os {

@@ -170,3 +170,66 @@ fn the_stanford_bunny_scans_read() {
     soup.validate().unwrap();
     assert!(soup.triangles.len() > 70_000, "{}", soup.triangles.len());
 }
+
+/// `bytes` of a range-image PLY without its grid: the `element range_grid` declaration, its
+/// property and its body lines dropped (an unorganised scan of the same points).
+fn without_grid(bytes: &[u8]) -> Vec<u8> {
+    let text = String::from_utf8_lossy(bytes);
+    let mut out = String::new();
+    let lines: Vec<&str> = text.split_inclusive('\n').collect();
+    let mut vertices = 0;
+    let mut i = 0;
+    while i < lines.len() {
+        let line = lines[i];
+        i += 1;
+        let words: Vec<&str> = line.split_whitespace().collect();
+        match words.as_slice() {
+            ["element", "vertex", n] => vertices = n.parse().unwrap(),
+            // The element and its property line.
+            ["element", "range_grid", _] => {
+                i += 1;
+                continue;
+            }
+            _ => {}
+        }
+        out += line;
+        if words == ["end_header"] {
+            break;
+        }
+    }
+    out.extend(lines[i..i + vertices].iter().copied());
+    out.into_bytes()
+}
+
+#[test]
+fn points_alone_read_as_an_unorganised_scan_close_to_the_gridded_patch() {
+    let Some(root) = std::env::var_os("ROAR_SCAN_DATA") else {
+        eprintln!("ROAR_SCAN_DATA is not set: skipping (CI sets it)");
+        return;
+    };
+    let path = PathBuf::from(root).join("stanford-bunny/bun000.ply");
+    let bytes = std::fs::read(&path).unwrap();
+    let gridded = roar_io::read_ply(&bytes, "bun000.ply").unwrap();
+    let points = without_grid(&bytes);
+    assert!(read_range_grid(&points, "points.ply").is_err());
+    let unorganised = roar_io::read_ply(&points, "points.ply").unwrap();
+    assert_eq!(unorganised.positions, gridded.positions);
+    let area = |soup: &roar_io::TriangleSoup| -> f64 {
+        soup.triangles
+            .iter()
+            .map(|t| {
+                let [a, b, c] = t.map(|i| soup.positions[i as usize]);
+                0.5 * (b - a).cross(c - a).length()
+            })
+            .sum()
+    };
+    let (g, u) = (area(&gridded), area(&unorganised));
+    eprintln!(
+        "bun000: gridded {} triangles, area {g:.6} m²; unorganised {} triangles, area {u:.6} m²",
+        gridded.triangles.len(),
+        unorganised.triangles.len()
+    );
+    // Measured: the Delaunay patch is 3.1 % larger (it bridges a few gaps the grid leaves open
+    // where the gaps are narrower than the edge filter's reach).
+    assert!((u / g - 1.0).abs() < 0.05, "{g} {u}");
+}

@@ -1,7 +1,8 @@
 //! A set of range scans as a [`Shape`]: the input kind `roar reconstruct` reads from a `.conf`
 //! (or the folder holding one).
 //!
-//! [`load_scans`] turns every range image into its patch (`roar_io::RangeGrid::patch`), places
+//! [`load_scans`] turns every scan into its patch (`roar_io::RangeGrid::patch` for range images,
+//! `roar_io::point_scan_patch` for points alone), places
 //! the patches by the `.conf` poses and refines the poses by ICP (`roar_ops::align`). The union
 //! of the aligned patches, holes and overlaps included, is the target: [`ScanShape`] hands it to
 //! the soup's preparation, init and sampling ([`SoupShape`]) with the init's enclosure rule on,
@@ -88,8 +89,7 @@ pub fn load_scans(
     let mut reports = Vec::with_capacity(set.scans.len());
     let mut poses = Vec::with_capacity(set.scans.len());
     for scan in &set.scans {
-        let grid = roar_io::read_range_grid_file(&scan.path)?;
-        let (patch, stats) = grid.patch(&options);
+        let (patch, stats) = roar_io::read_scan_patch_file(&scan.path, &options)?;
         let file = scan.path.display().to_string();
         if patch.triangles.is_empty() {
             return Err(IoError::in_file(
