@@ -3,8 +3,9 @@
 //! The points are projected onto the plane facing the scanner (the scan frame's xy plane; the
 //! scanner looks along [`SCANNER_VIEW`]), Delaunay-triangulated there (`spade`), and filtered as
 //! a range grid's patch is ([`PatchOptions`]): a triangle with an edge longer than
-//! `max_edge_factor` × the local spacing (the median length of the Delaunay edges at its
-//! corners) bridges a depth jump or the hull's concavity and is dropped, and so is a triangle
+//! `max_edge_factor` × the local spacing (the largest, over its corners, of the corner's
+//! shortest Delaunay edge: the sampling distance there, which long edges along the hull or
+//! across a gap do not inflate) bridges a depth jump or a gap and is dropped, and so is a triangle
 //! seen at a grazing angle; the rest face the scanner.
 
 use glam::DVec3;
@@ -28,26 +29,20 @@ pub fn point_scan_patch(positions: &[DVec3], options: &PatchOptions) -> (Triangl
             input_of.push(i as u32);
         }
     }
-    // Median 3-D length of the Delaunay edges at each vertex.
-    let mut incident: Vec<Vec<f64>> = vec![Vec::new(); input_of.len()];
+    // Shortest 3-D Delaunay edge at each vertex.
+    let mut nearest = vec![f64::INFINITY; input_of.len()];
     for edge in delaunay.undirected_edges() {
         let [a, b] = edge.vertices().map(|v| v.fix().index());
         let length = positions[input_of[a] as usize].distance(positions[input_of[b] as usize]);
-        incident[a].push(length);
-        incident[b].push(length);
+        nearest[a] = nearest[a].min(length);
+        nearest[b] = nearest[b].min(length);
     }
     let mut stats = PatchStats::default();
     let mut triangles = Vec::new();
     let toward_scanner = -SCANNER_VIEW;
-    let mut pooled = Vec::new();
     for face in delaunay.inner_faces() {
         let corners = face.vertices().map(|v| v.fix().index());
-        pooled.clear();
-        for &c in &corners {
-            pooled.extend_from_slice(&incident[c]);
-        }
-        let middle = pooled.len() / 2;
-        let local = *pooled.select_nth_unstable_by(middle, f64::total_cmp).1;
+        let local = corners.iter().map(|&c| nearest[c]).fold(0.0, f64::max);
         let t = corners.map(|c| input_of[c]);
         stats.candidates += 1;
         if let Some(t) =
