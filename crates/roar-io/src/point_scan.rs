@@ -5,7 +5,8 @@
 //! a range grid's patch is ([`PatchOptions`]): a triangle with an edge longer than
 //! `max_edge_factor` × the local spacing (the largest, over its corners, of the corner's
 //! shortest Delaunay edge: the sampling distance there, which long edges along the hull or
-//! across a gap do not inflate) bridges a depth jump or a gap and is dropped, and so is a triangle
+//! across a gap do not inflate; at most twice the scan's median of those, so sparse outliers
+//! far from the surface do not join up) bridges a depth jump or a gap and is dropped, and so is a triangle
 //! seen at a grazing angle; the rest face the scanner.
 
 use glam::DVec3;
@@ -37,12 +38,22 @@ pub fn point_scan_patch(positions: &[DVec3], options: &PatchOptions) -> (Triangl
         nearest[a] = nearest[a].min(length);
         nearest[b] = nearest[b].min(length);
     }
+    let mut sorted: Vec<f64> = nearest.iter().copied().filter(|d| d.is_finite()).collect();
+    let middle = sorted.len() / 2;
+    let cap = match sorted.is_empty() {
+        true => f64::INFINITY,
+        false => 2.0 * *sorted.select_nth_unstable_by(middle, f64::total_cmp).1,
+    };
     let mut stats = PatchStats::default();
     let mut triangles = Vec::new();
     let toward_scanner = -SCANNER_VIEW;
     for face in delaunay.inner_faces() {
         let corners = face.vertices().map(|v| v.fix().index());
-        let local = corners.iter().map(|&c| nearest[c]).fold(0.0, f64::max);
+        let local = corners
+            .iter()
+            .map(|&c| nearest[c])
+            .fold(0.0, f64::max)
+            .min(cap);
         let t = corners.map(|c| input_of[c]);
         stats.candidates += 1;
         if let Some(t) =
