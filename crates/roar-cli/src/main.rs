@@ -34,6 +34,9 @@ enum Command {
     Init(commands::init::InitArgs),
     /// Guaranteed QEM of a closed 2-manifold to exactly N faces, without new self-intersections.
     Decimate(commands::decimate::DecimateArgs),
+    /// Write the patches of a range-scan set (a `.conf` or its folder), aligned as
+    /// `reconstruct` aligns them, as one mesh to look at.
+    Scans(commands::scans::ScansArgs),
     /// Write the messy chair-like example soup that the README runs on.
     ExampleSoup(commands::example::ExampleArgs),
     /// Reconstruct every item of a manifest at one or more budgets, resumably, one child process
@@ -71,6 +74,7 @@ fn main() -> ExitCode {
         Command::Render(args) => commands::render::run(&args),
         Command::Init(args) => commands::init::run(&args),
         Command::Decimate(args) => commands::decimate::run(&args),
+        Command::Scans(args) => commands::scans::run(&args),
         Command::ExampleSoup(args) => commands::example::run(&args),
         Command::Batch(args) => commands::batch::run(&args),
         Command::BatchReport(args) => commands::batch_report::run(&args),

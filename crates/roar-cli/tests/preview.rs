@@ -90,6 +90,7 @@ fn the_flag_refuses_a_non_png_name_before_any_work() {
         resolution: None,
         seed: None,
         best_effort: false,
+        no_icp: false,
         report: None,
         preview: Some(dir.path().join("preview.jpg")),
         print_config: false,

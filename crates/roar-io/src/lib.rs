@@ -2,8 +2,9 @@
 //!
 //! [`TriangleSoup`] (plain buffers in which anything goes) and readers and writers for the mesh
 //! formats roar speaks: OBJ, PLY (ASCII, binary little and big endian), STL (ASCII and binary)
-//! and OFF; glTF 2.0 input (`.gltf`, `.glb`; see [`read_gltf_file`]); image dumps (PNG, EXR);
-//! atomic writes.
+//! and OFF; glTF 2.0 input (`.gltf`, `.glb`; see [`read_gltf_file`]); range scans (PLY range
+//! images, [`RangeGrid`], read as their patch anywhere a mesh is; Stanford `.conf` scan sets,
+//! [`read_scan_set`]); image dumps (PNG, EXR); atomic writes.
 //!
 //! ## Naming
 //!
@@ -35,7 +36,10 @@ mod image_dump;
 mod obj;
 mod off;
 mod ply;
+mod point_scan;
 mod polygon;
+mod range_grid;
+mod scan_set;
 mod soup;
 mod stl;
 mod text;
@@ -51,8 +55,13 @@ pub use gltf::{read_gltf, read_gltf_file};
 pub use image_dump::{write_exr_rgba, write_png_rgba8};
 pub use obj::{read_obj, write_obj};
 pub use off::{read_off, write_off};
-pub use ply::{PlyEncoding, read_ply, write_ply};
+pub use ply::{PlyEncoding, read_ply, read_range_grid, write_ply};
+pub use point_scan::point_scan_patch;
 pub use polygon::{MAX_EAR_CLIPPING_CORNERS, PLANARITY_TOLERANCE, triangulate_polygon};
+pub use range_grid::{PatchOptions, PatchStats, RangeGrid, SCANNER_VIEW};
+pub use scan_set::{
+    ScanPose, ScanSet, is_scan_set, read_range_grid_file, read_scan_patch_file, read_scan_set,
+};
 pub use soup::{SoupDefect, TriangleSoup};
 pub use stl::{StlEncoding, read_stl, write_stl};
 

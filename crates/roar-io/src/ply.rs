@@ -7,6 +7,13 @@
 //! (any scalar type) and the `face` element's `vertex_indices` (or `vertex_index`) list (any
 //! integer count and index type); polygons are fan-triangulated.
 //!
+//! A range image (`obj_info num_cols C` / `num_rows R` and an `element range_grid` of `C·R`
+//! lists holding no index or one vertex index, row-major, the Stanford scans' layout) is read
+//! by [`read_range_grid`]; [`read_ply`] turns a file with a range grid and no faces into its
+//! patch ([`crate::RangeGrid::patch`] with default options), so one scan is accepted anywhere a
+//! mesh is; a file of points alone is an unorganised scan, read as its Delaunay patch
+//! ([`crate::point_scan_patch`]).
+//!
 //! The writers emit `double x, y, z` and `list uchar uint vertex_indices`: binary output
 //! round-trips f64 bit for bit, and so does ASCII (shortest round-trip formatting).
 
@@ -111,6 +118,8 @@ struct Element {
     name: String,
     count: usize,
     properties: Vec<Property>,
+    /// 1-based header line of the `element` declaration (for errors about the element).
+    line: usize,
 }
 
 #[derive(Debug)]
@@ -121,6 +130,17 @@ struct Header {
     body: usize,
     /// 1-based line number of the body's first line (for ASCII errors).
     body_line: usize,
+    /// `obj_info num_cols` and `obj_info num_rows` (range images), when given.
+    grid_size: [Option<usize>; 2],
+}
+
+/// What a PLY body holds: its vertices, then its faces or its range grid.
+struct PlyBody {
+    positions: Vec<glam::DVec3>,
+    faces: Option<crate::text::Faces>,
+    /// The `range_grid` cells (row-major; `None` where the scanner saw nothing), with the
+    /// header's `[num_cols, num_rows]`, when the file has a range grid and no faces.
+    grid: Option<(Vec<Option<u32>>, [usize; 2])>,
 }
 
 /// Reads a PLY file in any of the three encodings; `file` names it in errors.
@@ -130,6 +150,90 @@ struct Header {
 /// range and faces with fewer than 3 corners (with the line for ASCII, the element index for
 /// binary), and no triangles.
 pub fn read_ply(bytes: &[u8], file: &str) -> Result<TriangleSoup, IoError> {
+    let body = read_ply_body(bytes, file)?;
+    let (cells, [cols, rows]) = match (body.faces, body.grid) {
+        (Some(faces), _) => {
+            return Ok(TriangleSoup {
+                positions: body.positions,
+                triangles: faces.triangles,
+                n_polygons: faces.n_polygons,
+                n_polygons_unclean: faces.n_polygons_unclean,
+            });
+        }
+        (None, Some(grid)) => grid,
+        (None, None) => {
+            let (patch, _) =
+                crate::point_scan_patch(&body.positions, &crate::PatchOptions::default());
+            if patch.triangles.is_empty() {
+                return Err(IoError::in_file(
+                    file,
+                    "PLY file has no faces and no range grid, and its points give no triangle \
+                     as an unorganised scan",
+                ));
+            }
+            return Ok(patch);
+        }
+    };
+    let grid = crate::RangeGrid {
+        cols,
+        rows,
+        positions: body.positions,
+        cells,
+    };
+    let (patch, _) = grid.patch(&crate::PatchOptions::default());
+    if patch.triangles.is_empty() {
+        return Err(IoError::in_file(
+            file,
+            "range grid has no triangle (no two neighbouring samples)",
+        ));
+    }
+    Ok(patch)
+}
+
+/// Reads a PLY range image (`obj_info num_cols/num_rows`, `element range_grid`; ASCII or
+/// binary, LF or CRLF); `file` names it in errors.
+///
+/// Errors, besides those of [`read_ply`]: no `range_grid` element, missing or zero
+/// `num_cols`/`num_rows`, a cell count other than `num_cols · num_rows` (at the element's header
+/// line), a cell with more than one index or an index past the vertex count (at its line).
+pub fn read_range_grid(bytes: &[u8], file: &str) -> Result<crate::RangeGrid, IoError> {
+    let body = read_ply_body(bytes, file)?;
+    let (cells, [cols, rows]) = body
+        .grid
+        .ok_or_else(|| IoError::in_file(file, "PLY file has no 'range_grid' element"))?;
+    Ok(crate::RangeGrid {
+        cols,
+        rows,
+        positions: body.positions,
+        cells,
+    })
+}
+
+/// A scan's patch from a PLY file: its range grid's ([`crate::RangeGrid::patch`]) or, for points
+/// alone, the unorganised scan's ([`crate::point_scan_patch`]); a file with faces is not a scan.
+pub(crate) fn read_scan_patch(
+    bytes: &[u8],
+    file: &str,
+    options: &crate::PatchOptions,
+) -> Result<(TriangleSoup, crate::PatchStats), IoError> {
+    let body = read_ply_body(bytes, file)?;
+    match (body.faces, body.grid) {
+        (Some(_), _) => Err(IoError::in_file(
+            file,
+            "a scan is a range grid or points alone, but this PLY file has faces",
+        )),
+        (None, Some((cells, [cols, rows]))) => Ok(crate::RangeGrid {
+            cols,
+            rows,
+            positions: body.positions,
+            cells,
+        }
+        .patch(options)),
+        (None, None) => Ok(crate::point_scan_patch(&body.positions, options)),
+    }
+}
+
+fn read_ply_body(bytes: &[u8], file: &str) -> Result<PlyBody, IoError> {
     let header = parse_header(bytes, file)?;
     let body = &bytes[header.body..];
     match header.encoding {
@@ -162,6 +266,7 @@ fn parse_header(bytes: &[u8], file: &str) -> Result<Header, IoError> {
     let mut line_no = 0;
     let mut encoding = None;
     let mut elements: Vec<Element> = Vec::new();
+    let mut grid_size = [None, None];
     loop {
         let Some(len) = bytes[pos..].iter().position(|&b| b == b'\n') else {
             return Err(if line_no == 0 && !bytes.starts_with(b"ply") {
@@ -190,6 +295,13 @@ fn parse_header(bytes: &[u8], file: &str) -> Result<Header, IoError> {
         }
         match toks.as_slice() {
             [] => {}
+            [b"obj_info", key @ (b"num_cols" | b"num_rows"), value] => {
+                let n = parse_i64(value)
+                    .and_then(|n| usize::try_from(n).ok())
+                    .filter(|&n| n > 0)
+                    .ok_or_else(|| err(format!("{} {:?} is invalid", show(key), show(value))))?;
+                grid_size[usize::from(*key == b"num_rows")] = Some(n);
+            }
             [b"comment", ..] | [b"obj_info", ..] => {}
             [b"format", kind, version] => {
                 if *version != b"1.0" {
@@ -210,6 +322,7 @@ fn parse_header(bytes: &[u8], file: &str) -> Result<Header, IoError> {
                     name: String::from_utf8_lossy(name).into_owned(),
                     count,
                     properties: Vec::new(),
+                    line: line_no,
                 });
             }
             [b"property", rest @ ..] => {
@@ -253,6 +366,7 @@ fn parse_header(bytes: &[u8], file: &str) -> Result<Header, IoError> {
         elements,
         body: pos,
         body_line: line_no + 1,
+        grid_size,
     })
 }
 
@@ -367,6 +481,8 @@ enum Role {
     Vertex([usize; 3]),
     /// The `face` element: property index of the index list.
     Face(usize),
+    /// The `range_grid` element: property index of its list of at most one vertex index.
+    Grid(usize),
     /// Anything else: read and drop.
     Skip,
 }
@@ -376,7 +492,7 @@ fn read_body(
     body_len: usize,
     file: &str,
     mut src: impl Source,
-) -> Result<TriangleSoup, IoError> {
+) -> Result<PlyBody, IoError> {
     let vertex = header
         .elements
         .iter()
@@ -386,24 +502,56 @@ fn read_body(
     if n_vertices > u32::MAX as usize {
         return Err(IoError::in_file(file, "more than 2^32 - 1 vertices"));
     }
-    let face = header
-        .elements
-        .iter()
-        .find(|e| e.name == "face")
-        .ok_or_else(|| IoError::in_file(file, "PLY header has no 'face' element"))?;
-    let face_list = face
-        .properties
-        .iter()
-        .position(|p| {
+    let face = header.elements.iter().find(|e| e.name == "face");
+    let grid = header.elements.iter().find(|e| e.name == "range_grid");
+    let index_list = |element: &Element| {
+        element.properties.iter().position(|p| {
             (p.name == "vertex_indices" || p.name == "vertex_index")
                 && matches!(p.kind, PropertyKind::List { item, .. } if item.is_integer())
         })
-        .ok_or_else(|| {
-            IoError::in_file(
-                file,
-                "PLY 'face' element has no integer list 'vertex_indices' or 'vertex_index'",
-            )
-        })?;
+    };
+    // Faces win when a file has both; a range grid is read only when there are no faces.
+    let mut grid_dims = None;
+    let (list_element, list_role) = match (face, grid) {
+        (Some(face), _) => {
+            let list = index_list(face).ok_or_else(|| {
+                IoError::in_file(
+                    file,
+                    "PLY 'face' element has no integer list 'vertex_indices' or 'vertex_index'",
+                )
+            })?;
+            (face, Role::Face(list))
+        }
+        (None, Some(grid)) => {
+            let list = index_list(grid).ok_or_else(|| {
+                IoError::in_file(
+                    file,
+                    "PLY 'range_grid' element has no integer list 'vertex_indices'",
+                )
+            })?;
+            let [Some(cols), Some(rows)] = header.grid_size else {
+                return Err(IoError::in_file(
+                    file,
+                    "range grid without 'obj_info num_cols' and 'obj_info num_rows'",
+                ));
+            };
+            if cols.checked_mul(rows) != Some(grid.count) {
+                return Err(IoError::at_line(
+                    file,
+                    grid.line,
+                    format!(
+                        "range_grid has {} cells, but num_cols {cols} x num_rows {rows} = {}",
+                        grid.count,
+                        cols.saturating_mul(rows)
+                    ),
+                ));
+            }
+            grid_dims = Some([cols, rows]);
+            (grid, Role::Grid(list))
+        }
+        // Points alone: an unorganised scan, read with no list element.
+        (None, None) => (vertex, Role::Skip),
+    };
     let mut xyz = [usize::MAX; 3];
     for (k, axis) in ["x", "y", "z"].iter().enumerate() {
         xyz[k] = vertex
@@ -418,14 +566,22 @@ fn read_body(
     // Never trust a count for an allocation larger than the file could hold.
     let mut positions = Vec::with_capacity(n_vertices.min(body_len));
     let mut fans = FanBuilder::default();
+    let mut cells: Vec<Option<u32>> = Vec::new();
     let mut corners: Vec<u32> = Vec::new();
     let mut coords = [0.0f64; 3];
 
     for element in &header.elements {
         let (role, kind) = if std::ptr::eq(element, vertex) {
             (Role::Vertex(xyz), "vertex")
-        } else if std::ptr::eq(element, face) {
-            (Role::Face(face_list), "face")
+        } else if std::ptr::eq(element, list_element) {
+            match list_role {
+                Role::Face(q) => (Role::Face(q), "face"),
+                Role::Grid(q) => {
+                    cells.reserve(element.count.min(body_len));
+                    (Role::Grid(q), "cell")
+                }
+                _ => (Role::Skip, "element"),
+            }
         } else {
             (Role::Skip, "element")
         };
@@ -467,27 +623,41 @@ fn read_body(
                         if k < 0 {
                             return Err(fail(&src, format!("negative list length {k}")));
                         }
-                        let keep = matches!(role, Role::Face(q) if q == p);
+                        let keep = matches!(role, Role::Face(q) | Role::Grid(q) if q == p);
                         corners.clear();
                         for _ in 0..k {
                             let value = src.read(item).map_err(|m| fail(&src, m))?;
                             if keep {
                                 let i = value.as_i64();
                                 if i < 0 || i >= n_vertices as i64 {
+                                    let what = if kind == "cell" { "vertex" } else { "face" };
                                     let msg = format!(
-                                        "face index {i} out of range (file has {n_vertices} vertices)"
+                                        "{what} index {i} out of range (file has {n_vertices} vertices)"
                                     );
                                     return Err(fail(&src, msg));
                                 }
                                 corners.push(i as u32);
                             }
                         }
-                        if keep {
-                            if k < 3 {
-                                let msg = format!("face has {k} corner(s); at least 3 are needed");
-                                return Err(fail(&src, msg));
+                        match role {
+                            Role::Face(q) if q == p => {
+                                if k < 3 {
+                                    let msg =
+                                        format!("face has {k} corner(s); at least 3 are needed");
+                                    return Err(fail(&src, msg));
+                                }
+                                fans.push_face(&corners);
                             }
-                            fans.push_face(&corners);
+                            Role::Grid(q) if q == p => {
+                                if k > 1 {
+                                    let msg = format!(
+                                        "a range grid cell holds 0 or 1 vertex index, not {k}"
+                                    );
+                                    return Err(fail(&src, msg));
+                                }
+                                cells.push(corners.first().copied());
+                            }
+                            _ => {}
                         }
                     }
                 }
@@ -499,16 +669,29 @@ fn read_body(
         }
     }
 
-    if fans.is_empty() {
-        return Err(IoError::in_file(file, "mesh has no faces"));
+    match grid_dims {
+        Some(dims) => Ok(PlyBody {
+            positions,
+            faces: None,
+            grid: Some((cells, dims)),
+        }),
+        None if face.is_none() => Ok(PlyBody {
+            positions,
+            faces: None,
+            grid: None,
+        }),
+        None => {
+            if fans.is_empty() {
+                return Err(IoError::in_file(file, "mesh has no faces"));
+            }
+            let faces = fans.finish(&positions);
+            Ok(PlyBody {
+                positions,
+                faces: Some(faces),
+                grid: None,
+            })
+        }
     }
-    let faces = fans.finish(&positions);
-    Ok(TriangleSoup {
-        positions,
-        triangles: faces.triangles,
-        n_polygons: faces.n_polygons,
-        n_polygons_unclean: faces.n_polygons_unclean,
-    })
 }
 
 /// Writes `soup` as PLY in the given encoding with `double x, y, z` and

@@ -12,10 +12,14 @@
 //! | loop and finish | [`untangle`] | the step limiter and the untangle block |
 //! | finish | [`finish`] | fill to the budget, outward offset, handle removal when the budget needs it, data flips, sliver flips, degenerate collapses |
 //!
+//! Before the stages, for range scans: [`align`] (trimmed point-to-plane ICP of scan patches).
+//!
 //! Shared by several stages: [`geometry`] (per-mesh normals, quality measures), [`quadric`] (the
 //! error quadrics of the decimation and of the QSlim edge costs) and a private
 //! exact face–face intersection test. Dependencies run down this table's stages and into the
 //! shared modules; no two modules import each other.
+
+pub mod align;
 
 pub mod init;
 

@@ -225,6 +225,7 @@ fn reconstruct_args(
         resolution: args.resolution,
         seed: item.and_then(|i| i.seed).or(args.seed),
         best_effort: args.best_effort,
+        no_icp: false,
         report: None,
         print_config: false,
         quiet: true,

@@ -10,3 +10,4 @@ pub mod info;
 pub mod init;
 pub mod reconstruct;
 pub mod render;
+pub mod scans;

@@ -18,15 +18,17 @@ use roar_mesh::spatial::{Aabb, evaluate_with_gradients};
 
 use crate::pipeline::sdf::{DEFAULT_BOUNDS, SdfReport};
 use crate::pipeline::{
-    InitKind, Progress as PipelineProgress, ReconstructConfig, Reconstruction, RunStats, SdfShape,
-    SoupShape,
+    InitKind, Progress as PipelineProgress, ReconstructConfig, Reconstruction, RunStats,
+    ScanReport, ScanShape, SdfShape, SoupShape, load_scans,
 };
 
 /// Arguments of `roar reconstruct`.
 #[derive(Args, Debug)]
 pub struct ReconstructArgs {
-    /// Any triangle soup (OBJ, PLY, STL or OFF), or a signed distance function: a neural MLP
-    /// (`.npz`) or an analytic shape (`.sdf.toml`), negative inside (`docs/sdf.md`).
+    /// Any triangle soup (OBJ, PLY, STL or OFF; a PLY range image is its patch), a set of range
+    /// scans (a Stanford `.conf` or the folder holding one; `docs/scans.md`), or a signed
+    /// distance function: a neural MLP (`.npz`) or an analytic shape (`.sdf.toml`), negative
+    /// inside (`docs/sdf.md`).
     pub input: Option<PathBuf>,
     /// Where to write the result (format by extension).
     #[arg(short, long)]
@@ -55,6 +57,9 @@ pub struct ReconstructArgs {
     /// Keep the genus: fail when the budget is too small for it instead of removing handles.
     #[arg(long)]
     pub keep_topology: bool,
+    /// Range scans: keep the `.conf` poses (no ICP).
+    #[arg(long)]
+    pub no_icp: bool,
     /// Also write the JSON report to this file.
     #[arg(long)]
     pub report: Option<PathBuf>,
@@ -119,6 +124,9 @@ pub struct ReconstructReport {
     pub run: RunStats,
     /// The effective configuration.
     pub config: ReconstructConfig,
+    /// Range scans: each scan's patch and alignment (absent for other inputs).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub scans: Option<Vec<ScanReport>>,
     /// For an SDF input: its evaluations by stage and how far the output is from its zero set.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub sdf: Option<SdfRunReport>,
@@ -173,17 +181,29 @@ pub fn run(args: &ReconstructArgs) -> anyhow::Result<()> {
     if roar_sdf::is_sdf_path(input) {
         return run_sdf(args, config, input, started);
     }
-    let soup = roar_io::read_mesh(input)?;
+    let scans = if roar_io::is_scan_set(input) {
+        Some(load_scans(input, &config, config.scan_icp)?)
+    } else {
+        None
+    };
+    let soup = match &scans {
+        Some(scans) => scans.union(),
+        None => roar_io::read_mesh(input)?,
+    };
     check_resources(&config, soup.triangles.len(), args.force)?;
 
     let mut progress = Progress::new(args.quiet, config.iterations);
-    let mut shape = SoupShape::new(file_name(input), &soup.positions, &soup.triangles, &config);
+    let name = file_name(input);
     let mut reconstruction = Reconstruction::new(config.clone());
-    let result = reconstruction
-        .run(&mut shape, &mut |p| progress.report(p))
-        .with_context(|| format!("{}: reconstruction failed", input.display()));
-    // The prepared target and its renders are not needed for the report.
-    drop(shape);
+    // The shape (its prepared target and renders) lives only as long as the run.
+    let result = if scans.is_some() {
+        let mut shape = ScanShape::new(name, &soup.positions, &soup.triangles, &config);
+        reconstruction.run(&mut shape, &mut |p| progress.report(p))
+    } else {
+        let mut shape = SoupShape::new(name, &soup.positions, &soup.triangles, &config);
+        reconstruction.run(&mut shape, &mut |p| progress.report(p))
+    }
+    .with_context(|| format!("{}: reconstruction failed", input.display()));
     progress.finish();
     let result = result?;
 
@@ -209,8 +229,15 @@ pub fn run(args: &ReconstructArgs) -> anyhow::Result<()> {
         output_metrics,
         run: result.stats,
         config,
+        scans: scans.map(|s| s.reports),
         sdf: None,
     };
+    for scan in report.scans.iter().flatten().filter(|s| !s.overlaps) {
+        eprintln!(
+            "note: {} overlaps too little of the other scans for ICP; it keeps its .conf pose",
+            scan.file
+        );
+    }
     write_outputs(
         args,
         &report,
@@ -326,6 +353,7 @@ fn run_sdf(
         output_metrics,
         run: result.stats,
         config,
+        scans: None,
         sdf: Some(SdfRunReport {
             evaluations,
             output_distance_mean: distances.iter().sum::<f64>() / distances.len().max(1) as f64,
@@ -333,6 +361,31 @@ fn run_sdf(
         }),
     };
     write_outputs(args, &report, &out_soup, None)
+}
+
+/// `defaults` overridden by the keys of the TOML file at `path`, if any; a parse error or an
+/// unknown key is one line naming the file.
+pub fn read_config(
+    path: Option<&std::path::Path>,
+    defaults: ReconstructConfig,
+) -> anyhow::Result<ReconstructConfig> {
+    let Some(path) = path else {
+        return Ok(defaults);
+    };
+    let text =
+        std::fs::read_to_string(path).with_context(|| format!("cannot read {}", path.display()))?;
+    let one_line = |e: toml::de::Error| {
+        anyhow::anyhow!("{}: {}", path.display(), e.to_string().replace('\n', " "))
+    };
+    // Parsed alone first, so unknown keys and bad values are named against the file.
+    let file: ReconstructConfig = toml::from_str(&text).map_err(one_line)?;
+    if defaults == ReconstructConfig::default() {
+        return Ok(file);
+    }
+    // The file's keys over other defaults (an SDF input's schedule).
+    let mut table = toml::Table::try_from(&defaults)?;
+    table.extend(toml::from_str::<toml::Table>(&text).map_err(one_line)?);
+    table.try_into().map_err(one_line)
 }
 
 /// Defaults, then the TOML file, then the flags.
@@ -344,25 +397,7 @@ pub fn effective_config(args: &ReconstructArgs) -> anyhow::Result<ReconstructCon
     } else {
         ReconstructConfig::default()
     };
-    let mut config = match &args.config {
-        Some(path) => {
-            let text = std::fs::read_to_string(path)
-                .with_context(|| format!("cannot read {}", path.display()))?;
-            let one_line = |e: toml::de::Error| {
-                anyhow::anyhow!("{}: {}", path.display(), e.to_string().replace('\n', " "))
-            };
-            let file: ReconstructConfig = toml::from_str(&text).map_err(one_line)?;
-            if sdf_input {
-                // The file's keys over the SDF defaults rather than over the soup's.
-                let mut table = toml::Table::try_from(&defaults)?;
-                table.extend(toml::from_str::<toml::Table>(&text).map_err(one_line)?);
-                table.try_into().map_err(one_line)?
-            } else {
-                file
-            }
-        }
-        None => defaults,
-    };
+    let mut config = read_config(args.config.as_deref(), defaults)?;
     if let Some(faces) = args.faces {
         config.faces = faces;
     }
@@ -372,6 +407,9 @@ pub fn effective_config(args: &ReconstructArgs) -> anyhow::Result<ReconstructCon
         } else {
             InitKind::Watertight
         };
+    }
+    if args.no_icp {
+        config.scan_icp = false;
     }
     if let Some(iterations) = args.iterations {
         config.iterations = iterations;

@@ -188,6 +188,15 @@ pub struct ReconstructConfig {
     pub sliver_quality: f64,
     /// Write the closest mesh when the final QEM cannot reach the budget, instead of failing.
     pub best_effort: bool,
+    /// Range scans: a patch triangle with an edge longer than this many times the local grid
+    /// spacing bridges a depth jump and is dropped (`roar_io::PatchOptions::max_edge_factor`,
+    /// where the default is measured).
+    pub scan_max_edge_factor: f64,
+    /// Range scans: a patch triangle whose normal is more than this many degrees from the
+    /// direction to the scanner is dropped (`roar_io::PatchOptions::max_angle_degrees`).
+    pub scan_max_angle_degrees: f64,
+    /// Range scans: refine the `.conf` poses by ICP (`roar_ops::align`); `--no-icp` turns it off.
+    pub scan_icp: bool,
     /// Keep the init's genus to the end: when the budget is too small for it (or the final QEM
     /// stalls on the link condition) the run fails with the QEM's named error instead of
     /// removing handles (`roar_ops::finish::genus`; DESIGN.md §2).
@@ -264,6 +273,9 @@ impl Default for ReconstructConfig {
             polish_iterations: 20,
             sliver_quality: 10.0,
             best_effort: false,
+            scan_max_edge_factor: 4.0,
+            scan_max_angle_degrees: 80.0,
+            scan_icp: true,
             keep_topology: false,
             sdf_loss_weight: 0.1,
             sdf_loss_start: 500,
@@ -343,6 +355,14 @@ impl ReconstructConfig {
                 self.enclosure_winding_threshold,
             ),
             (r("sphere_level", 0.0, 8.0), f64::from(self.sphere_level)),
+            (
+                r("scan_max_edge_factor", 1.0, 1e3),
+                self.scan_max_edge_factor,
+            ),
+            (
+                r("scan_max_angle_degrees", 1.0, 90.0),
+                self.scan_max_angle_degrees,
+            ),
             (
                 r("working_budget_factor", 1.0, 100.0),
                 self.working_budget_factor as f64,
