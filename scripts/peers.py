@@ -4,8 +4,10 @@
     peers.py METHOD INPUT OUTDIR --budgets 1000 5000
 
 METHOD is `alphawrap` (CGAL 3D Alpha Wrapping through PyMeshLab, alpha = diag/300,
-offset = diag/1000) or `manifold` (Huang et al. 2018 through point-cloud-utils'
-`make_mesh_watertight`, resolution 20000). The peer runs once; its surface is then
+offset = diag/1000), `manifold` (Huang et al. 2018 through point-cloud-utils'
+`make_mesh_watertight`, resolution 20000), `poisson` (Screened Poisson through PyMeshLab,
+depth 8, on the input's vertices with area-weighted normals of its oriented faces, for
+range-scan patches) or `qem` (no reconstruction: the input itself, decimated). The peer runs once; its surface is then
 decimated to each budget with MeshLab's topology-preserving quadric edge collapse
 (`preservetopology`, `preservenormal`, `planarquadric`), and written as
 `OUTDIR/<budget>.obj`.
@@ -19,6 +21,7 @@ the whole evaluation down.
 import argparse
 import json
 import os
+import resource
 import sys
 import time
 
@@ -29,6 +32,7 @@ import pymeshlab
 ALPHA_OVER_DIAG = 1.0 / 300.0
 OFFSET_OVER_DIAG = 1.0 / 1000.0
 MANIFOLD_RESOLUTION = 20000
+POISSON_DEPTH = 8
 
 
 def load(path):
@@ -78,6 +82,25 @@ def manifold(v, f):
     return np.asarray(vw, dtype=np.float64), np.asarray(fw, dtype=np.int32), "resolution=20000"
 
 
+def poisson(v, f):
+    """Screened Poisson (Kazhdan & Hoppe 2013) through PyMeshLab, depth 8, on the vertices with
+    the area-weighted normals of the faces around them (patches face their scanner)."""
+    ms = pymeshlab.MeshSet()
+    ms.add_mesh(pymeshlab.Mesh(vertex_matrix=v, face_matrix=f))
+    ms.compute_normal_per_vertex(weightmode="By Area")
+    ms.generate_surface_reconstruction_screened_poisson(depth=POISSON_DEPTH, preclean=True)
+    m = ms.current_mesh()
+    return m.vertex_matrix(), m.face_matrix(), "depth=%d" % POISSON_DEPTH
+
+
+def as_is(v, f):
+    """The input unchanged (the `qem` method decimates it alone)."""
+    return v, f, "input decimated"
+
+
+PEERS = {"alphawrap": alpha_wrap, "manifold": manifold, "poisson": poisson, "qem": as_is}
+
+
 def decimate(v, f, faces):
     """MeshLab QEM to `faces`, topology preserved; returns (vertices, faces, seconds)."""
     ms = pymeshlab.MeshSet()
@@ -107,7 +130,7 @@ def write_obj(path, v, f):
 
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("method", choices=["alphawrap", "manifold"])
+    parser.add_argument("method", choices=sorted(PEERS))
     parser.add_argument("input")
     parser.add_argument("outdir")
     parser.add_argument("--budgets", type=int, nargs="+", required=True)
@@ -117,7 +140,7 @@ def main():
     v, f = load(args.input)
     result = {"method": args.method, "input_faces": int(len(f)), "budgets": {}}
     started = time.perf_counter()
-    peer = alpha_wrap if args.method == "alphawrap" else manifold
+    peer = PEERS[args.method]
     pv, pf, params = peer(v, f)
     result["peer_seconds"] = time.perf_counter() - started
     result["peer_faces"] = int(len(pf))
@@ -141,6 +164,8 @@ def main():
         except Exception as e:  # one budget failing must not hide the others
             entry = {"error": "%s: %s" % (type(e).__name__, e)}
         result["budgets"][str(budget)] = entry
+    # Peak resident memory of this process (the peer and its QEM), in bytes.
+    result["peak_bytes"] = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024
     json.dump(result, sys.stdout)
     print()
 
