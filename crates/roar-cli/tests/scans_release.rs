@@ -7,7 +7,7 @@ mod common;
 
 use std::path::PathBuf;
 
-use roar_cli::pipeline::{Reconstruction, ScanShape, load_scans};
+use roar_cli::pipeline::{ReconstructConfig, Reconstruction, SoupShape, load_scans};
 use roar_eval::{ChamferOptions, fidelity};
 use roar_mesh::Mesh;
 use roar_mesh::spatial::self_intersecting_faces;
@@ -50,7 +50,11 @@ fn three_bunny_scans_reconstruct_to_a_closed_genus_0_mesh_of_exactly_the_budget(
     let Some(conf) = three_scans(dir.path()) else {
         return;
     };
-    let config = common::toy_config(FACES, 30);
+    // The scan defaults' enclosure rule on top of the toy schedule.
+    let config = ReconstructConfig {
+        enclosure_winding_threshold: ReconstructConfig::scan_defaults().enclosure_winding_threshold,
+        ..common::toy_config(FACES, 30)
+    };
     let scans = load_scans(&conf, &config, true).unwrap();
     assert_eq!(scans.reports.len(), 3);
     for scan in &scans.reports {
@@ -61,7 +65,7 @@ fn three_bunny_scans_reconstruct_to_a_closed_genus_0_mesh_of_exactly_the_budget(
         assert!(scan.overlaps, "{}", scan.file);
     }
     let union = scans.union();
-    let mut shape = ScanShape::new("three", &union.positions, &union.triangles, &config);
+    let mut shape = SoupShape::new("three", &union.positions, &union.triangles, &config);
     let out = Reconstruction::new(config)
         .run(&mut shape, &mut |_| {})
         .unwrap();

@@ -19,7 +19,7 @@ use roar_mesh::spatial::{Aabb, evaluate_with_gradients};
 use crate::pipeline::sdf::{DEFAULT_BOUNDS, SdfReport};
 use crate::pipeline::{
     InitKind, Progress as PipelineProgress, ReconstructConfig, Reconstruction, RunStats,
-    ScanReport, ScanShape, SdfShape, SoupShape, load_scans,
+    ScanReport, SdfShape, SoupShape, load_scans,
 };
 
 /// Arguments of `roar reconstruct`.
@@ -193,17 +193,13 @@ pub fn run(args: &ReconstructArgs) -> anyhow::Result<()> {
     check_resources(&config, soup.triangles.len(), args.force)?;
 
     let mut progress = Progress::new(args.quiet, config.iterations);
-    let name = file_name(input);
+    let mut shape = SoupShape::new(file_name(input), &soup.positions, &soup.triangles, &config);
     let mut reconstruction = Reconstruction::new(config.clone());
-    // The shape (its prepared target and renders) lives only as long as the run.
-    let result = if scans.is_some() {
-        let mut shape = ScanShape::new(name, &soup.positions, &soup.triangles, &config);
-        reconstruction.run(&mut shape, &mut |p| progress.report(p))
-    } else {
-        let mut shape = SoupShape::new(name, &soup.positions, &soup.triangles, &config);
-        reconstruction.run(&mut shape, &mut |p| progress.report(p))
-    }
-    .with_context(|| format!("{}: reconstruction failed", input.display()));
+    let result = reconstruction
+        .run(&mut shape, &mut |p| progress.report(p))
+        .with_context(|| format!("{}: reconstruction failed", input.display()));
+    // The prepared target and its renders are not needed for the report.
+    drop(shape);
     progress.finish();
     let result = result?;
 
@@ -391,11 +387,10 @@ pub fn read_config(
 /// Defaults, then the TOML file, then the flags.
 /// The defaults are the SDF schedule's ([`ReconstructConfig::sdf_defaults`]) for an SDF input.
 pub fn effective_config(args: &ReconstructArgs) -> anyhow::Result<ReconstructConfig> {
-    let sdf_input = args.input.as_deref().is_some_and(roar_sdf::is_sdf_path);
-    let defaults = if sdf_input {
-        ReconstructConfig::sdf_defaults()
-    } else {
-        ReconstructConfig::default()
+    let defaults = match args.input.as_deref() {
+        Some(input) if roar_sdf::is_sdf_path(input) => ReconstructConfig::sdf_defaults(),
+        Some(input) if roar_io::is_scan_set(input) => ReconstructConfig::scan_defaults(),
+        _ => ReconstructConfig::default(),
     };
     let mut config = read_config(args.config.as_deref(), defaults)?;
     if let Some(faces) = args.faces {

@@ -37,7 +37,7 @@ pub fn run(args: &ScansArgs) -> anyhow::Result<()> {
     roar_io::MeshFormat::for_writing(&args.output)?;
     let config = crate::commands::reconstruct::read_config(
         args.config.as_deref(),
-        ReconstructConfig::default(),
+        ReconstructConfig::scan_defaults(),
     )?;
     config
         .validate()

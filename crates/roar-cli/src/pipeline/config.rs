@@ -301,6 +301,16 @@ impl ReconstructConfig {
         }
     }
 
+    /// The defaults for a set of range scans: the soup's, with the init's enclosure rule on at
+    /// [`crate::pipeline::scans::SCAN_ENCLOSURE_WINDING_THRESHOLD`], since a scanned object is
+    /// closed but the scanner never sees all of it (the bunny's base).
+    pub fn scan_defaults() -> Self {
+        Self {
+            enclosure_winding_threshold: crate::pipeline::scans::SCAN_ENCLOSURE_WINDING_THRESHOLD,
+            ..Self::default()
+        }
+    }
+
     /// W = clamp(factor·N, min, max), never below N (DESIGN.md §2).
     pub fn working_budget(&self) -> usize {
         let w = (self.working_budget_factor * self.faces)

@@ -10,7 +10,7 @@
 //!   → smoothing → data flips → polish → denormalize
 //! ```
 //!
-//! The input is any [`Shape`] (the soup is [`SoupShape`], a set of range scans [`ScanShape`]): the pipeline asks it for its
+//! The input is any [`Shape`] (a soup or a set of range scans is a [`SoupShape`], an SDF an [`SdfShape`]): the pipeline asks it for its
 //! normalization, target renders, point cloud and initial mesh, and never which kind it is.
 //! A researcher swaps a piece without forking a crate: [`Reconstruction::loss_factory`] builds
 //! the objective from what the shape gave, and [`Reconstruction::blocks`] is the remeshing
@@ -48,9 +48,7 @@ use roar_render::{Camera, Image, star_cameras};
 use serde::Serialize;
 
 pub use config::{InitKind, ReconstructConfig};
-pub use scans::{
-    AlignedScans, SCAN_ENCLOSURE_WINDING_THRESHOLD, ScanReport, ScanShape, load_scans,
-};
+pub use scans::{AlignedScans, SCAN_ENCLOSURE_WINDING_THRESHOLD, ScanReport, load_scans};
 pub use sdf::SdfShape;
 pub use soup::SoupShape;
 

@@ -1,26 +1,20 @@
-//! A set of range scans as a [`Shape`]: the input kind `roar reconstruct` reads from a `.conf`
+//! A set of range scans as an input: the kind `roar reconstruct` reads from a `.conf`
 //! (or the folder holding one).
 //!
 //! [`load_scans`] turns every scan into its patch (`roar_io::RangeGrid::patch` for range images,
 //! `roar_io::point_scan_patch` for points alone), places
 //! the patches by the `.conf` poses and refines the poses by ICP (`roar_ops::align`). The union
-//! of the aligned patches, holes and overlaps included, is the target: [`ScanShape`] hands it to
-//! the soup's preparation, init and sampling ([`SoupShape`]) with the init's enclosure rule on,
-//! since a scanned object is closed but the scanner never sees all of it (the bunny's base).
+//! of the aligned patches, holes and overlaps included, is the target: a [`crate::pipeline::SoupShape`]
+//! of it, with the scan defaults' enclosure rule (`ReconstructConfig::scan_defaults`), since a
+//! scanned object is closed but the scanner never sees all of it (the bunny's base).
 
-use std::borrow::Cow;
 use std::path::Path;
 
-use glam::DVec3;
 use roar_io::{IoError, PatchOptions, TriangleSoup};
-use roar_loss::{InitialMesh, PointCloud, Shape, ShapeError, ShapeSummary};
-use roar_mesh::Mesh;
-use roar_mesh::spatial::Normalization;
 use roar_ops::align::{AlignOptions, RigidTransform, ScanPatch, align_scans};
-use roar_render::{Camera, Image};
 use serde::Serialize;
 
-use super::{ReconstructConfig, SoupShape};
+use super::ReconstructConfig;
 
 /// What happened to one scan, for reports.
 #[derive(Debug, Clone, Serialize)]
@@ -140,64 +134,10 @@ pub fn load_scans(
     Ok(AlignedScans { patches, reports })
 }
 
-/// The enclosure rule's threshold for scan sets (`enclosure_winding_threshold`), below the
+/// The enclosure rule's threshold for scan sets (`enclosure_winding_threshold` of
+/// `ReconstructConfig::scan_defaults`), below the
 /// soups' `roar_ops::init::ENCLOSURE_WINDING_THRESHOLD` (0.7) because scans leave wider
 /// openings: four bunny scans around its side (bun000, bun090, bun180, bun270; top and base
 /// unscanned) give an init of genus 1 at 0.7 (a tunnel from top to base) and of genus 0 at 0.6
 /// and 0.5.
 pub const SCAN_ENCLOSURE_WINDING_THRESHOLD: f64 = 0.6;
-
-/// The union of aligned scan patches as a [`Shape`]: a [`SoupShape`] of the union whose
-/// watertight init uses the enclosure rule ([`SCAN_ENCLOSURE_WINDING_THRESHOLD`] unless the
-/// config sets a value), so the unscanned parts of a closed object close.
-pub struct ScanShape<'a> {
-    soup: SoupShape<'a>,
-}
-
-impl<'a> ScanShape<'a> {
-    /// The union `positions`/`triangles` of aligned patches ([`AlignedScans::union`]).
-    pub fn new(
-        name: impl Into<String>,
-        positions: &'a [DVec3],
-        triangles: &'a [[u32; 3]],
-        config: &ReconstructConfig,
-    ) -> Self {
-        let mut config = config.clone();
-        if config.enclosure_winding_threshold == 0.0 {
-            config.enclosure_winding_threshold = SCAN_ENCLOSURE_WINDING_THRESHOLD;
-        }
-        Self {
-            soup: SoupShape::new(name, positions, triangles, &config),
-        }
-    }
-}
-
-impl Shape for ScanShape<'_> {
-    fn name(&self) -> &str {
-        self.soup.name()
-    }
-
-    fn prepare(&mut self, cameras: &[Camera]) -> Result<(), ShapeError> {
-        self.soup.prepare(cameras)
-    }
-
-    fn normalization(&self) -> Normalization {
-        self.soup.normalization()
-    }
-
-    fn initial_mesh(&self) -> Result<InitialMesh, ShapeError> {
-        self.soup.initial_mesh()
-    }
-
-    fn point_cloud(&self, initial: &Mesh) -> Result<PointCloud, ShapeError> {
-        self.soup.point_cloud(initial)
-    }
-
-    fn target_renders(&self, cameras: &[Camera]) -> Result<Cow<'_, [Image]>, ShapeError> {
-        self.soup.target_renders(cameras)
-    }
-
-    fn summary(&self) -> ShapeSummary {
-        self.soup.summary()
-    }
-}
