@@ -15,10 +15,13 @@ trap 'rm -rf "$work"' EXIT
 cd "$work"
 "$roar" example-soup chair.obj 2>/dev/null
 cat > small.toml <<TOML
-iterations = 40
+[target]
 views_per_axis = 3
 render_resolution = 128
+[init]
 init_resolution = 64
+[optimize]
+iterations = 40
 TOML
 echo "id,path,seed" > manifest.csv
 for i in $(seq 0 $((n - 1))); do echo "item$i,chair.obj,$i" >> manifest.csv; done

@@ -50,7 +50,7 @@ bad = si.get("faces")
 ok = t["faces"] == n and t["watertight"] and t["boundary_edges"] == 0 \
     and t["nonmanifold_edges"] == 0 and bad == 0
 print("\t".join(map(str, ["ok" if ok else "FAIL", t["faces"], t["watertight"], bad,
-    r["run"]["init_genus"], t["genus"], len(r["run"]["handles_removed"]),
+    r["run"]["init"]["init_genus"], t["genus"], len(r["run"]["finish"]["handles_removed"]),
     "%.1f" % float(sys.argv[3])])))
 PY
 )

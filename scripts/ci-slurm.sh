@@ -120,14 +120,18 @@ for ext in obj ply off stl; do
   "$roar" example-soup "$data/chair.$ext" 2>/dev/null
 done
 cat > "$data/tiny.toml" <<TOML
-init_resolution = 32
-init_max_faces = 4000
-working_budget_min = 600
+[target]
 views_per_axis = 2
 render_resolution = 64
 point_cloud_samples = 5000
 sharp_edge_samples = 1000
+[init]
+init_resolution = 32
+init_max_faces = 4000
+[loss]
 planar_max_samples = 5000
+[optimize]
+working_budget_min = 600
 split_interval = 3
 smoothing_interval = 2
 TOML

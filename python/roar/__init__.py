@@ -106,7 +106,7 @@ def reconstruct(
     ``target_faces`` faces and no self-intersections.
 
     ``config`` overrides configuration keys (the CLI's TOML layout, e.g.
-    ``{"iterations": 100, "seed": 7}``). ``progress``, if given, is called with a dict
+    ``{"optimize": {"iterations": 100}, "seed": 7}``). ``progress``, if given, is called with a dict
     ``{"stage", "iteration", "iterations", "loss", "faces"}`` at every report the CLI's progress
     bar shows; an exception it raises stops the run and propagates.
 

@@ -77,12 +77,13 @@ fn roar_error(e: impl std::fmt::Display) -> PyErr {
 /// The effective config: defaults, then the JSON of the user's dict (the CLI's TOML layout),
 /// then the face budget; validated like the CLI's.
 fn effective_config(config_json: &str, faces: usize) -> PyResult<ReconstructConfig> {
-    let mut config: ReconstructConfig = serde_json::from_str(config_json)
-        .map_err(|e| PyValueError::new_err(format!("config: {e}")))?;
+    let config_error = |e: String| PyValueError::new_err(format!("config: {e}"));
+    let table: toml::Table =
+        serde_json::from_str(config_json).map_err(|e| config_error(e.to_string()))?;
+    let mut config = ReconstructConfig::from_table(table, &ReconstructConfig::default())
+        .map_err(config_error)?;
     config.faces = faces;
-    config
-        .validate()
-        .map_err(|e| PyValueError::new_err(format!("config: {e}")))?;
+    config.validate().map_err(config_error)?;
     Ok(config)
 }
 

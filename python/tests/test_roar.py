@@ -18,17 +18,20 @@ EXAMPLE = REPO / "examples" / "chair_soup.obj"
 
 # Toy settings (as the Rust pipeline tests use): seconds, not minutes.
 TOY = {
-    "iterations": 6,
-    "init_resolution": 32,
-    "init_max_faces": 4000,
-    "working_budget_min": 600,
-    "views_per_axis": 2,
-    "render_resolution": 64,
-    "point_cloud_samples": 5000,
-    "sharp_edge_samples": 1000,
-    "planar_max_samples": 5000,
-    "split_interval": 3,
-    "smoothing_interval": 2,
+    "target": {
+        "views_per_axis": 2,
+        "render_resolution": 64,
+        "point_cloud_samples": 5000,
+        "sharp_edge_samples": 1000,
+    },
+    "init": {"init_resolution": 32, "init_max_faces": 4000},
+    "loss": {"planar_max_samples": 5000},
+    "optimize": {
+        "iterations": 6,
+        "working_budget_min": 600,
+        "split_interval": 3,
+        "smoothing_interval": 2,
+    },
 }
 
 
@@ -52,7 +55,7 @@ def test_round_trip_with_trimesh():
     assert mesh.volume > 0
     assert report["output_metrics"]["topology"]["faces"] == 200
     assert report["input"] == "<arrays>"
-    assert report["config"]["iterations"] == TOY["iterations"]
+    assert report["config"]["optimize"]["iterations"] == TOY["optimize"]["iterations"]
     # Same seed, same input: the same mesh, from any accepted dtype.
     again = roar.reconstruct(v.astype(np.float64), f.astype(np.uint32), 200, config=TOY)
     assert np.array_equal(again[0], out_v) and np.array_equal(again[1], out_f)
@@ -92,6 +95,8 @@ def test_bad_config_and_budget_raise_value_error():
     v, f = example()
     with pytest.raises(ValueError, match="unknown field"):
         roar.reconstruct(v, f, 200, config={"no_such_key": 1})
+    with pytest.raises(ValueError, match=r"belongs in the \[loss\] table"):
+        roar.reconstruct(v, f, 200, config={"render_weight": 1.0})
     with pytest.raises(ValueError, match="config"):
         roar.reconstruct(v, f, 201, config=TOY)
     with pytest.raises(ValueError, match="target_faces"):
@@ -134,7 +139,7 @@ def test_progress_gets_the_cli_records_and_its_exception_stops_the_run():
 
 def test_ctrl_c_raises_keyboard_interrupt_and_stops_the_run():
     v, f = example()
-    long_run = dict(TOY, iterations=500)
+    long_run = dict(TOY, optimize=dict(TOY["optimize"], iterations=500))
     optimize = []
 
     def on_progress(record):
@@ -146,7 +151,7 @@ def test_ctrl_c_raises_keyboard_interrupt_and_stops_the_run():
 
     with pytest.raises(KeyboardInterrupt):
         roar.reconstruct(v, f, 200, config=long_run, progress=on_progress)
-    assert len(optimize) < long_run["iterations"]
+    assert len(optimize) < long_run["optimize"]["iterations"]
 
 
 def test_another_thread_runs_while_roar_works():

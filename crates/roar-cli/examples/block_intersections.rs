@@ -4,7 +4,7 @@
 //! `cargo run --release -p roar-cli --example block_intersections -- FILE [FACES] [RESOLUTION]`.
 //! Diagnostic only: the exact all-pairs check after every block makes the run much slower.
 
-use roar_cli::pipeline::{ReconstructConfig, Reconstruction, ScheduledBlock};
+use roar_cli::pipeline::{InitConfig, ReconstructConfig, Reconstruction, ScheduledBlock};
 use roar_mesh::TrackedMesh;
 use roar_mesh::spatial::count_intersecting_faces;
 use roar_ops::blocks::block::{Block, BlockContext, BlockStats};
@@ -59,7 +59,10 @@ fn main() {
     let soup = roar_io::read_mesh(Path::new(&args[0])).expect("readable mesh");
     let config = ReconstructConfig {
         faces: args.get(1).map_or(1000, |s| s.parse().unwrap()),
-        init_resolution: args.get(2).map_or(128, |s| s.parse().unwrap()),
+        init: InitConfig {
+            init_resolution: args.get(2).map_or(128, |s| s.parse().unwrap()),
+            ..Default::default()
+        },
         ..ReconstructConfig::default()
     };
     let tally: Tally = Rc::default();
@@ -80,7 +83,7 @@ fn main() {
         .expect("reconstruction");
     println!(
         "untangle failures {:?}, finished from iteration {}",
-        out.stats.untangle_failures, out.stats.finished_from_iteration
+        out.stats.optimize.untangle_failures, out.stats.optimize.finished_from_iteration
     );
     for (name, (times, faces)) in tally.borrow().by_block.iter() {
         println!("{name}: raised the count {times} times, by {faces} faces in total");

@@ -11,7 +11,9 @@ use std::f64::consts::TAU;
 use std::path::PathBuf;
 
 use glam::DVec3;
-use roar_cli::pipeline::{ReconstructConfig, Reconstruction};
+use roar_cli::pipeline::{
+    FinishConfig, LossConfig, OptimizeConfig, ReconstructConfig, Reconstruction, TargetConfig,
+};
 use roar_io::TriangleSoup;
 use roar_loss::{InitialMesh, PointCloud, Shape, ShapeError, render_views};
 use roar_mesh::Mesh;
@@ -108,13 +110,25 @@ fn main() -> anyhow::Result<()> {
     // Toy settings: 9 views of 96², 20 iterations; `ReconstructConfig::default()` is the paper's.
     let config = ReconstructConfig {
         faces: 800,
-        iterations: 20,
-        working_budget_min: 1600,
-        views_per_axis: 3,
-        render_resolution: 96,
-        planar_max_samples: 6000,
-        split_interval: 5,
-        polish_iterations: 5,
+        target: TargetConfig {
+            views_per_axis: 3,
+            render_resolution: 96,
+            ..Default::default()
+        },
+        loss: LossConfig {
+            planar_max_samples: 6000,
+            ..Default::default()
+        },
+        optimize: OptimizeConfig {
+            iterations: 20,
+            working_budget_min: 1600,
+            split_interval: 5,
+            ..Default::default()
+        },
+        finish: FinishConfig {
+            polish_iterations: 5,
+            ..Default::default()
+        },
         ..ReconstructConfig::default()
     };
     let out = Reconstruction::new(config).run(&mut shape, &mut |_| {})?;

@@ -10,7 +10,8 @@ use std::path::PathBuf;
 use glam::DVec3;
 use roar_cli::example::chair_soup;
 use roar_cli::pipeline::{
-    PipelineError, Prepared, ReconstructConfig, Reconstruction, ScheduledBlock, default_loss,
+    FinishConfig, InitConfig, LossConfig, OptimizeConfig, PipelineError, Prepared,
+    ReconstructConfig, Reconstruction, ScheduledBlock, TargetConfig, default_loss,
 };
 use roar_io::TriangleSoup;
 use roar_loss::{Loss, LossError, WeightedSum};
@@ -117,17 +118,32 @@ fn main() -> anyhow::Result<()> {
     // seconds; `ReconstructConfig::default()` is what `roar reconstruct` uses.
     let config = ReconstructConfig {
         faces: 600,
-        iterations: 30,
-        init_resolution: 48,
-        init_max_faces: 4000,
-        working_budget_min: 1200,
-        views_per_axis: 2,
-        render_resolution: 64,
-        point_cloud_samples: 5000,
-        sharp_edge_samples: 1000,
-        planar_max_samples: 5000,
-        split_interval: 5,
-        polish_iterations: 5,
+        target: TargetConfig {
+            views_per_axis: 2,
+            render_resolution: 64,
+            point_cloud_samples: 5000,
+            sharp_edge_samples: 1000,
+            ..Default::default()
+        },
+        init: InitConfig {
+            init_resolution: 48,
+            init_max_faces: 4000,
+            ..Default::default()
+        },
+        loss: LossConfig {
+            planar_max_samples: 5000,
+            ..Default::default()
+        },
+        optimize: OptimizeConfig {
+            iterations: 30,
+            working_budget_min: 1200,
+            split_interval: 5,
+            ..Default::default()
+        },
+        finish: FinishConfig {
+            polish_iterations: 5,
+            ..Default::default()
+        },
         ..ReconstructConfig::default()
     };
     let mut reconstruction = Reconstruction::new(config);
@@ -152,15 +168,15 @@ fn main() -> anyhow::Result<()> {
         .iter()
         .filter(|&&c| c)
         .count();
-    let last = out.stats.history.last().map(|r| &r.terms);
+    let last = out.stats.optimize.history.last().map(|r| &r.terms);
     println!(
         "{} faces, genus {}, {crossing} self-intersecting faces; loss {:.4} -> {:.4}; \
          last loop terms {last:?}; accepted operations per block {:?}",
         out.triangles.len(),
         mesh.genus(),
-        out.stats.loss_first,
-        out.stats.loss_last,
-        out.stats.block_accepted,
+        out.stats.optimize.loss_first,
+        out.stats.optimize.loss_last,
+        out.stats.optimize.block_accepted,
     );
     // The pipeline's promises hold whatever the loss and blocks: `from_triangles` accepted a
     // closed, oriented 2-manifold; the budget is exact and no face crosses another.

@@ -43,7 +43,10 @@ fn main() -> anyhow::Result<()> {
     let cloud = point_cloud(&target, &PointCloudOptions::default())?;
 
     let (_, render) = RenderLoss::new(&target).value_and_grad(&positions, &triangles)?;
-    let render: Vec<DVec3> = render.iter().map(|g| config.render_weight * *g).collect();
+    let render: Vec<DVec3> = render
+        .iter()
+        .map(|g| config.loss.render_weight * *g)
+        .collect();
     let mut raw = PlanarLoss::new(&cloud.points, &cloud.normals, &PlanarOptions::raw())?;
     let (_, planar_raw) = raw.value_and_grad(&positions, &triangles)?;
     let mut scaled = PlanarLoss::new(&cloud.points, &cloud.normals, &PlanarOptions::default())?;
@@ -60,7 +63,7 @@ fn main() -> anyhow::Result<()> {
         }
     }
     let laplacian: Vec<DVec3> = (0..positions.len())
-        .map(|v| config.laplacian_weight * (positions[v] - sum[v] / count[v] as f64))
+        .map(|v| config.optimize.laplacian_weight * (positions[v] - sum[v] / count[v] as f64))
         .collect();
 
     println!(
@@ -71,7 +74,7 @@ fn main() -> anyhow::Result<()> {
     println!("mean |grad| per vertex:");
     println!(
         "  render × {}      {:.3e}",
-        config.render_weight,
+        config.loss.render_weight,
         mean_norm(&render)
     );
     println!("  planar raw × 1      {:.3e}", mean_norm(&planar_raw));

@@ -26,8 +26,8 @@ use std::time::Instant;
 
 use glam::DVec3;
 use roar_cli::pipeline::{
-    PipelineError, Prepared, ReconstructConfig, Reconstruction, default_loss, planar_options,
-    target_options,
+    OptimizeConfig, PipelineError, Prepared, ReconstructConfig, Reconstruction, default_loss,
+    planar_options, target_options,
 };
 use roar_loss::{Loss, LossError, PlanarLoss, PointCloud, RenderLoss, build_target};
 
@@ -92,7 +92,10 @@ fn dump(mesh: &Path, state: &Path, faces: usize, at: usize) -> anyhow::Result<()
     let soup = roar_io::read_mesh(mesh)?;
     let config = ReconstructConfig {
         faces,
-        iterations: at + 1,
+        optimize: OptimizeConfig {
+            iterations: at + 1,
+            ..Default::default()
+        },
         ..ReconstructConfig::default()
     };
     let mut run = Reconstruction::new(config);

@@ -5,9 +5,10 @@ use std::path::Path;
 use std::process::{Command, Output};
 
 /// Settings that make an item take seconds: few views, coarse renders, a coarse init.
-const TINY: &str = "init_resolution = 32\ninit_max_faces = 4000\nworking_budget_min = 600\n\
-views_per_axis = 2\nrender_resolution = 64\npoint_cloud_samples = 5000\n\
-sharp_edge_samples = 1000\nplanar_max_samples = 5000\nsplit_interval = 3\nsmoothing_interval = 2\n";
+const TINY: &str = "[target]\nviews_per_axis = 2\nrender_resolution = 64\npoint_cloud_samples = 5000\n\
+sharp_edge_samples = 1000\n[init]\ninit_resolution = 32\ninit_max_faces = 4000\n\
+[loss]\nplanar_max_samples = 5000\n\
+[optimize]\nworking_budget_min = 600\nsplit_interval = 3\nsmoothing_interval = 2\n";
 
 fn roar(dir: &Path, args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_roar"))

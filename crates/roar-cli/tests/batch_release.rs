@@ -10,9 +10,10 @@ use std::path::Path;
 use std::process::{Child, Command, Stdio};
 use std::time::{Duration, Instant};
 
-const TINY: &str = "init_resolution = 32\ninit_max_faces = 4000\nworking_budget_min = 600\n\
-views_per_axis = 2\nrender_resolution = 64\npoint_cloud_samples = 5000\n\
-sharp_edge_samples = 1000\nplanar_max_samples = 5000\nsplit_interval = 3\nsmoothing_interval = 2\n";
+const TINY: &str = "[target]\nviews_per_axis = 2\nrender_resolution = 64\npoint_cloud_samples = 5000\n\
+sharp_edge_samples = 1000\n[init]\ninit_resolution = 32\ninit_max_faces = 4000\n\
+[loss]\nplanar_max_samples = 5000\n\
+[optimize]\nworking_budget_min = 600\nsplit_interval = 3\nsmoothing_interval = 2\n";
 
 /// Positions (0-based) of the failing items; none is in shard 1, the one that is killed.
 const BAD_FILE: usize = 8;

@@ -4,21 +4,47 @@
 
 use roar_cli::pipeline::ReconstructConfig;
 
-/// The default configuration with `key` set to `value`, parsed as a user's TOML file would be.
+/// The default configuration with `key` (`faces`, or `table.leaf` as the ranges name it) set to
+/// `value`, parsed as a user's TOML file would be.
 fn with(key: &str, value: toml::Value) -> Result<ReconstructConfig, String> {
-    let mut table = toml::Table::try_from(ReconstructConfig::default()).unwrap();
-    table.insert(key.to_string(), value);
-    toml::from_str::<ReconstructConfig>(&toml::to_string(&table).unwrap())
-        .map_err(|e| e.to_string())
+    let defaults = ReconstructConfig::default();
+    let mut table = toml::Table::try_from(&defaults).unwrap();
+    match key.split_once('.') {
+        Some((stage, leaf)) => {
+            let stage = table[stage].as_table_mut().unwrap();
+            assert!(stage.contains_key(leaf), "no field {key}");
+            stage.insert(leaf.to_string(), value);
+        }
+        None => {
+            table.insert(key.to_string(), value);
+        }
+    }
+    ReconstructConfig::from_toml(&toml::to_string(&table).unwrap(), &defaults)
+}
+
+/// Every scalar of the config's TOML layout by its dotted name (`loss.render_weight`).
+fn scalars(config: &ReconstructConfig) -> Vec<(String, toml::Value)> {
+    let mut out = Vec::new();
+    for (key, value) in toml::Table::try_from(config).unwrap() {
+        match value {
+            toml::Value::Table(leaves) => out.extend(
+                leaves
+                    .into_iter()
+                    .map(|(leaf, v)| (format!("{key}.{leaf}"), v)),
+            ),
+            value => out.push((key, value)),
+        }
+    }
+    out
 }
 
 #[test]
 fn every_numeric_field_has_a_range() {
     let config = ReconstructConfig::default();
     config.validate().unwrap();
-    let table = toml::Table::try_from(&config).unwrap();
+    let fields = scalars(&config);
     let ranged: Vec<&str> = config.field_ranges().iter().map(|(r, _)| r.name).collect();
-    for (key, value) in &table {
+    for (key, value) in &fields {
         if value.is_integer() || value.is_float() {
             assert!(
                 ranged.contains(&key.as_str()),
@@ -27,15 +53,22 @@ fn every_numeric_field_has_a_range() {
         }
     }
     for name in &ranged {
-        assert!(table.contains_key(*name), "range for unknown field {name}");
+        assert!(
+            fields.iter().any(|(key, _)| key == name),
+            "range for unknown field {name}"
+        );
     }
 }
 
 #[test]
 fn every_numeric_field_refuses_values_outside_its_range() {
     let defaults = ReconstructConfig::default();
+    let fields = scalars(&defaults);
     for (range, default) in defaults.field_ranges() {
-        let integer = toml::Table::try_from(&defaults).unwrap()[range.name].is_integer();
+        let integer = fields
+            .iter()
+            .any(|(key, v)| key == range.name && v.is_integer());
+        let leaf = range.name.rsplit('.').next().unwrap();
         let probes = [
             f64::NAN,
             f64::INFINITY,
@@ -64,7 +97,7 @@ fn every_numeric_field_refuses_values_outside_its_range() {
                     "{} = {probe} did not parse: {message}",
                     range.name
                 );
-                assert!(message.contains(range.name), "{}: {message}", range.name);
+                assert!(message.contains(leaf), "{}: {message}", range.name);
                 continue;
             }
             match (parsed.unwrap().validate(), expected_ok) {
@@ -90,18 +123,20 @@ fn every_numeric_field_refuses_values_outside_its_range() {
 
 #[test]
 fn range_errors_name_field_value_and_range() {
-    let config = with("render_weight", toml::Value::Float(f64::NAN)).unwrap();
+    let config = with("loss.render_weight", toml::Value::Float(f64::NAN)).unwrap();
     assert_eq!(
         config.validate().unwrap_err(),
-        "render_weight = NaN is out of range: allowed 0 to 1000000"
+        "loss.render_weight = NaN is out of range: allowed 0 to 1000000"
     );
-    let config = with("sliver_quality", toml::Value::Float(0.5)).unwrap();
+    let config = with("finish.sliver_quality", toml::Value::Float(0.5)).unwrap();
     assert!(config.validate().unwrap_err().contains("0 (off) or 1 to"));
 }
 
 #[test]
 fn working_budget_bounds_must_be_ordered() {
-    let config = with("working_budget_min", toml::Value::Integer(30_000)).unwrap();
+    let config = with("optimize.working_budget_min", toml::Value::Integer(30_000)).unwrap();
     let message = config.validate().unwrap_err();
-    assert!(message.contains("working_budget_min = 30000 is above working_budget_max = 20000"));
+    assert!(message.contains(
+        "optimize.working_budget_min = 30000 is above optimize.working_budget_max = 20000"
+    ));
 }

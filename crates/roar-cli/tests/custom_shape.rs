@@ -8,7 +8,10 @@ use std::rc::Rc;
 use std::sync::Arc;
 
 use glam::DVec3;
-use roar_cli::pipeline::{Prepared, ReconstructConfig, Reconstruction, default_loss};
+use roar_cli::pipeline::{
+    FinishConfig, LossConfig, OptimizeConfig, Prepared, ReconstructConfig, Reconstruction,
+    TargetConfig, default_loss,
+};
 use roar_loss::{
     InitialMesh, PointCloud, Sdf, SdfEvaluations, Shape, ShapeError, ShapeSummary, render_views,
 };
@@ -142,13 +145,25 @@ impl Shape for AnalyticSphere {
 fn toy_config() -> ReconstructConfig {
     ReconstructConfig {
         faces: 400,
-        iterations: 20,
-        working_budget_min: 800,
-        views_per_axis: 3,
-        render_resolution: 96,
-        planar_max_samples: 4000,
-        split_interval: 5,
-        polish_iterations: 5,
+        target: TargetConfig {
+            views_per_axis: 3,
+            render_resolution: 96,
+            ..Default::default()
+        },
+        loss: LossConfig {
+            planar_max_samples: 4000,
+            ..Default::default()
+        },
+        optimize: OptimizeConfig {
+            iterations: 20,
+            working_budget_min: 800,
+            split_interval: 5,
+            ..Default::default()
+        },
+        finish: FinishConfig {
+            polish_iterations: 5,
+            ..Default::default()
+        },
         ..ReconstructConfig::default()
     }
 }
@@ -167,7 +182,7 @@ fn an_analytic_sphere_is_reconstructed_through_the_shape_seam() {
     let radius = 2.5;
     let mut shape = AnalyticSphere::new(center, radius);
     let config = toy_config();
-    let cameras = config.views_per_axis * config.views_per_axis;
+    let cameras = config.target.views_per_axis * config.target.views_per_axis;
 
     // The loss factory sees what the shape offers.
     let saw_distance = Rc::new(Cell::new(false));
@@ -188,8 +203,8 @@ fn an_analytic_sphere_is_reconstructed_through_the_shape_seam() {
     let mesh = Mesh::from_triangles(out.positions.clone(), &out.triangles).unwrap();
     assert_eq!(mesh.genus(), 0);
     assert!(!self_intersecting_faces(&out.positions, &out.triangles).contains(&true));
-    assert_eq!(out.stats.init_faces, 1280);
-    assert_eq!(out.stats.point_cloud, 4000);
+    assert_eq!(out.stats.init.init_faces, 1280);
+    assert_eq!(out.stats.target.point_cloud, 4000);
 
     // In the input's coordinates, on the sphere: the init sat 10 % inside it.
     let error = worst_radius_error(&out.positions, center, radius);

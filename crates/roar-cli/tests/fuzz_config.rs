@@ -17,10 +17,13 @@ fn the_config_parser_survives_mutated_seeds() {
     let executions = mutate::executions(2_000);
     let seeds: Vec<Vec<u8>> = [
         toml::to_string(&ReconstructConfig::default()).unwrap(),
-        "faces = 1000\niterations = 20\ninit = \"sphere\"\n".to_string(),
-        "render_weight = 3.0\nplanar_weight = 1e-3\nsliver_quality = 0\n".to_string(),
-        "working_budget_min = 100\nworking_budget_max = 200\nseed = 18446744073709551615\n"
+        "faces = 1000\n[optimize]\niterations = 20\n[init]\nkind = \"sphere\"\n".to_string(),
+        "[loss]\nrender_weight = 3.0\nplanar_weight = 1e-3\n[finish]\nsliver_quality = 0\n"
             .to_string(),
+        "seed = 18446744073709551615\n[optimize]\nworking_budget_min = 100\nworking_budget_max = 200\n"
+            .to_string(),
+        // The ungrouped layout, refused with the table each key belongs in.
+        "iterations = 20\nrender_weight = 3.0\ninit = \"sphere\"\n".to_string(),
     ]
     .into_iter()
     .map(String::into_bytes)
@@ -37,7 +40,7 @@ fn the_config_parser_survives_mutated_seeds() {
         mutate::mutate(&mut rng, &mut bytes, &seeds);
         let outcome = catch_unwind(AssertUnwindSafe(|| {
             let text = String::from_utf8_lossy(&bytes);
-            toml::from_str::<ReconstructConfig>(&text).map(|c| c.validate())
+            ReconstructConfig::from_toml(&text, &ReconstructConfig::default()).map(|c| c.validate())
         }));
         match outcome {
             Ok(Ok(Ok(()))) => valid += 1,

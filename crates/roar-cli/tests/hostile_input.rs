@@ -76,7 +76,7 @@ fn colliding_input_output_report_and_config_are_refused() {
     let hard = dir.path().join("hard.obj");
     std::fs::hard_link(&soup, &hard).unwrap();
     let config = dir.path().join("c.toml");
-    std::fs::write(&config, "iterations = 0\n").unwrap();
+    std::fs::write(&config, "[optimize]\niterations = 0\n").unwrap();
     for args in [
         vec!["-o", s(&out), "--report", s(&out)],
         vec!["-o", s(&out), "--report", s(&soup)],
@@ -142,11 +142,22 @@ fn garbage_values_are_refused_before_reading_the_input() {
     // The input does not exist: a refusal naming the field proves the check came first.
     let input = dir.path().join("never-read.obj");
     for (line, field) in [
-        ("laplacian_weight = nan", "laplacian_weight"),
-        ("render_weight = inf", "render_weight"),
-        ("point_cloud_samples = 0", "point_cloud_samples"),
-        ("planar_neighbours = 0", "planar_neighbours"),
-        ("working_budget_min = 30000", "working_budget_min"),
+        (
+            "[optimize]\nlaplacian_weight = nan",
+            "optimize.laplacian_weight",
+        ),
+        ("[loss]\nrender_weight = inf", "loss.render_weight"),
+        (
+            "[target]\npoint_cloud_samples = 0",
+            "target.point_cloud_samples",
+        ),
+        ("[loss]\nplanar_neighbours = 0", "loss.planar_neighbours"),
+        (
+            "[optimize]\nworking_budget_min = 30000",
+            "optimize.working_budget_min",
+        ),
+        ("render_weight = 1", "[loss]"),
+        ("[loss]\niterations = 1", "[optimize]"),
     ] {
         let config = dir.path().join("c.toml");
         std::fs::write(&config, format!("{line}\n")).unwrap();

@@ -31,7 +31,7 @@ fn the_preview_shows_input_output_wireframe_and_curve() {
     let out = Reconstruction::new(common::toy_config(200, 6))
         .run_soup(&soup.positions, &soup.triangles, &mut |_| {})
         .unwrap();
-    let losses: Vec<f64> = out.stats.history.iter().map(|r| r.loss).collect();
+    let losses: Vec<f64> = out.stats.optimize.history.iter().map(|r| r.loss).collect();
     let options = PreviewOptions { tile: 96 };
     let image = preview_image(
         (&soup.positions, &soup.triangles),

@@ -80,9 +80,10 @@ fn reconstruct(name: &str, soup: &roar_io::TriangleSoup) -> Run {
         faces: FACES,
         ..ReconstructConfig::default()
     };
-    let baseline_config = ReconstructConfig {
-        iterations: 0,
-        ..config.clone()
+    let baseline_config = {
+        let mut config = config.clone();
+        config.optimize.iterations = 0;
+        config
     };
     let baseline = Reconstruction::new(baseline_config)
         .run_soup(&soup.positions, &soup.triangles, &mut |_| {})
@@ -127,7 +128,7 @@ fn reconstruction_beats_init_plus_qem_and_keeps_every_promise() {
         mesh.validate().unwrap();
         assert!(mesh.signed_volume() > 0.0, "{name}: outward orientation");
         assert!(
-            mesh.components().0 <= out.stats.init_components,
+            mesh.components().0 <= out.stats.init.init_components,
             "{name}: more components than the init"
         );
         let crossing = self_intersecting_faces(&out.positions, &out.triangles)

@@ -17,7 +17,7 @@ fn toy_config(faces: usize) -> ReconstructConfig {
 
 fn run(config: ReconstructConfig) -> (Vec<glam::DVec3>, Vec<[u32; 3]>, usize) {
     let (positions, triangles, stats) = run_with(config, Vec::new());
-    (positions, triangles, stats.init_components)
+    (positions, triangles, stats.init.init_components)
 }
 
 /// Runs the toy pipeline with `extra` blocks scheduled after the default ones.
@@ -26,8 +26,8 @@ fn run_with(
     extra: Vec<ScheduledBlock>,
 ) -> (Vec<glam::DVec3>, Vec<[u32; 3]>, RunStats) {
     let soup = roar_cli::example::chair_soup();
-    let config_iterations = config.iterations;
-    let (polish_iterations, faces) = (config.polish_iterations, config.faces);
+    let config_iterations = config.optimize.iterations;
+    let (polish_iterations, faces) = (config.finish.polish_iterations, config.faces);
     let mut stages = Vec::new();
     let mut reconstruction = Reconstruction::new(config);
     reconstruction.blocks.extend(extra);
@@ -40,8 +40,8 @@ fn run_with(
         assert!(stages.contains(&stage), "progress never reported {stage}");
     }
     // The report's history has one record per iteration whose terms add up to the loss.
-    assert_eq!(out.stats.history.len(), config_iterations);
-    for record in &out.stats.history {
+    assert_eq!(out.stats.optimize.history.len(), config_iterations);
+    for record in &out.stats.optimize.history {
         let names: Vec<&str> = record.terms.keys().copied().collect();
         assert_eq!(names, ["planar", "render"]);
         let sum: f64 = record.terms.values().sum();
@@ -49,7 +49,7 @@ fn run_with(
     }
     // One polish per QEM of the finish: at 2N first when the loop's mesh had more faces than
     // that, then at exactly the budget.
-    let stages: &[usize] = if out.stats.loop_faces > 2 * faces {
+    let stages: &[usize] = if out.stats.optimize.loop_faces > 2 * faces {
         &[2 * faces, faces]
     } else {
         &[faces]
@@ -58,7 +58,13 @@ fn run_with(
         .iter()
         .flat_map(|&n| std::iter::repeat_n(n, polish_iterations))
         .collect();
-    let polished: Vec<usize> = out.stats.polish_history.iter().map(|r| r.faces).collect();
+    let polished: Vec<usize> = out
+        .stats
+        .finish
+        .polish_history
+        .iter()
+        .map(|r| r.faces)
+        .collect();
     assert_eq!(polished, expected);
     (out.positions, out.triangles, out.stats)
 }
@@ -97,9 +103,10 @@ impl Block for Scramble {
 
 #[test]
 fn a_tangle_made_in_the_loop_is_never_the_state_the_run_finishes_from() {
-    let config = ReconstructConfig {
-        checkpoint_interval: 2,
-        ..toy_config(300)
+    let config = {
+        let mut config = toy_config(300);
+        config.optimize.checkpoint_interval = 2;
+        config
     };
     // Scrambled at iteration 4, after the state of iteration 4 was kept: every later state is
     // a tangle with a high loss (and one the untangle cannot clear).
@@ -110,9 +117,9 @@ fn a_tangle_made_in_the_loop_is_never_the_state_the_run_finishes_from() {
     };
     let (positions, triangles, stats) = run_with(config, vec![scramble]);
     assert!(
-        stats.finished_from_iteration <= 4,
+        stats.optimize.finished_from_iteration <= 4,
         "finished from the tangled state of iteration {}",
-        stats.finished_from_iteration
+        stats.optimize.finished_from_iteration
     );
     assert_eq!(triangles.len(), 300);
     let mesh = Mesh::from_triangles(positions.clone(), &triangles).unwrap();
@@ -124,9 +131,10 @@ fn a_tangle_made_in_the_loop_is_never_the_state_the_run_finishes_from() {
 #[test]
 fn toy_reconstruction_is_closed_exact_and_intersection_free() {
     for init in [InitKind::Watertight, InitKind::Sphere] {
-        let (positions, triangles, init_components) = run(ReconstructConfig {
-            init,
-            ..toy_config(300)
+        let (positions, triangles, init_components) = run({
+            let mut config = toy_config(300);
+            config.init.kind = init;
+            config
         });
         assert_eq!(triangles.len(), 300, "{init:?}");
         let mesh = Mesh::from_triangles(positions.clone(), &triangles).unwrap();
@@ -154,7 +162,7 @@ fn same_input_config_and_seed_give_the_same_bits() {
 fn the_final_mesh_is_smoothed_at_the_budget_without_intersections() {
     let (positions, triangles, stats) = run_with(toy_config(300), Vec::new());
     assert!(
-        stats.final_smoothing_moves > 0,
+        stats.finish.final_smoothing_moves > 0,
         "the final sweeps moved nothing"
     );
     assert_eq!(triangles.len(), 300);
@@ -175,9 +183,9 @@ fn a_torus_asked_for_fewer_faces_than_its_genus_allows_loses_its_handle() {
     let out = Reconstruction::new(toy_config(12))
         .run_soup(&positions, &triangles, &mut |_| {})
         .unwrap();
-    assert_eq!(out.stats.init_genus, 1);
-    assert_eq!(out.stats.handles_removed.len(), 1);
-    assert!(out.stats.handles_removed[0].loop_length > 0.0);
+    assert_eq!(out.stats.init.init_genus, 1);
+    assert_eq!(out.stats.finish.handles_removed.len(), 1);
+    assert!(out.stats.finish.handles_removed[0].loop_length > 0.0);
     assert_eq!(out.triangles.len(), 12);
     let mesh = Mesh::from_triangles(out.positions.clone(), &out.triangles).unwrap();
     mesh.validate().unwrap();
@@ -191,7 +199,7 @@ fn a_budget_the_genus_allows_keeps_the_handle() {
     let out = Reconstruction::new(toy_config(200))
         .run_soup(&positions, &triangles, &mut |_| {})
         .unwrap();
-    assert!(out.stats.handles_removed.is_empty());
+    assert!(out.stats.finish.handles_removed.is_empty());
     let mesh = Mesh::from_triangles(out.positions.clone(), &out.triangles).unwrap();
     assert_eq!((mesh.n_faces(), mesh.genus()), (200, 1));
 }
@@ -199,9 +207,10 @@ fn a_budget_the_genus_allows_keeps_the_handle() {
 #[test]
 fn keep_topology_fails_with_the_named_error_instead() {
     let (positions, triangles) = torus_soup();
-    let config = ReconstructConfig {
-        keep_topology: true,
-        ..toy_config(12)
+    let config = {
+        let mut config = toy_config(12);
+        config.finish.keep_topology = true;
+        config
     };
     // The budget is checked against the init's pieces and genera right after the init, so
     // the run fails in seconds, naming the torus's smallest budget (14), not after the loop.

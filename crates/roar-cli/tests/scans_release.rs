@@ -51,9 +51,12 @@ fn three_bunny_scans_reconstruct_to_a_closed_genus_0_mesh_of_exactly_the_budget(
         return;
     };
     // The scan defaults' enclosure rule on top of the toy schedule.
-    let config = ReconstructConfig {
-        enclosure_winding_threshold: ReconstructConfig::scan_defaults().enclosure_winding_threshold,
-        ..common::toy_config(FACES, 30)
+    let config = {
+        let mut config = common::toy_config(FACES, 30);
+        config.init.enclosure_winding_threshold = ReconstructConfig::scan_defaults()
+            .init
+            .enclosure_winding_threshold;
+        config
     };
     let scans = load_scans(&conf, &config, true).unwrap();
     assert_eq!(scans.reports.len(), 3);

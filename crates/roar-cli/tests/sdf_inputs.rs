@@ -33,8 +33,11 @@ fn print_config_of_an_sdf_input_gives_the_sdf_schedule() {
     assert!(out.status.success());
     let config: ReconstructConfig = toml::from_str(&String::from_utf8_lossy(&out.stdout)).unwrap();
     assert_eq!(config, ReconstructConfig::sdf_defaults());
-    assert_eq!((config.iterations, config.faces), (700, 50_000));
-    assert_eq!((config.sdf_loss_weight, config.sdf_loss_start), (0.1, 500));
+    assert_eq!((config.optimize.iterations, config.faces), (700, 50_000));
+    assert_eq!(
+        (config.loss.sdf_loss_weight, config.loss.sdf_loss_start),
+        (0.1, 500)
+    );
     // A config file's keys go over the SDF defaults, not the soup's.
     let file = dir.path().join("c.toml");
     std::fs::write(&file, "faces = 1000\n").unwrap();
@@ -54,7 +57,7 @@ fn print_config_of_an_sdf_input_gives_the_sdf_schedule() {
         file.to_str().unwrap(),
     ]);
     let config: ReconstructConfig = toml::from_str(&String::from_utf8_lossy(&out.stdout)).unwrap();
-    assert_eq!((config.iterations, config.faces), (700, 1000));
+    assert_eq!((config.optimize.iterations, config.faces), (700, 1000));
 }
 
 #[test]
@@ -104,11 +107,12 @@ fn bad_sdf_files_fail_in_one_line_and_write_nothing() {
 /// gradient evaluations per sample of every face, every `split_interval` iterations).
 fn toy_sdf_config(faces: usize, split_projector: bool) -> ReconstructConfig {
     let iterations = 30;
-    ReconstructConfig {
-        sdf_loss_start: iterations / 2,
-        sdf_split_projector: split_projector,
-        sdf_trace_grid: 64,
-        ..common::toy_config(faces, iterations)
+    {
+        let mut config = common::toy_config(faces, iterations);
+        config.target.sdf_trace_grid = 64;
+        config.loss.sdf_loss_start = iterations / 2;
+        config.optimize.sdf_split_projector = split_projector;
+        config
     }
 }
 

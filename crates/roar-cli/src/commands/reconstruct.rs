@@ -182,7 +182,7 @@ pub fn run(args: &ReconstructArgs) -> anyhow::Result<()> {
         return run_sdf(args, config, input, started);
     }
     let scans = if roar_io::is_scan_set(input) {
-        Some(load_scans(input, &config, config.scan_icp)?)
+        Some(load_scans(input, &config, config.target.scan_icp)?)
     } else {
         None
     };
@@ -192,7 +192,7 @@ pub fn run(args: &ReconstructArgs) -> anyhow::Result<()> {
     };
     check_resources(&config, soup.triangles.len(), args.force)?;
 
-    let mut progress = Progress::new(args.quiet, config.iterations);
+    let mut progress = Progress::new(args.quiet, config.optimize.iterations);
     let mut shape = SoupShape::new(file_name(input), &soup.positions, &soup.triangles, &config);
     let mut reconstruction = Reconstruction::new(config.clone());
     let result = reconstruction
@@ -250,7 +250,7 @@ fn write_outputs(
     input_soup: Option<(&[DVec3], &[[u32; 3]])>,
 ) -> anyhow::Result<()> {
     let output = args.output.as_ref().context("-o OUTPUT is required")?;
-    for failure in &report.run.untangle_failures {
+    for failure in &report.run.optimize.untangle_failures {
         eprintln!(
             "note: {} faces of the loop's state at iteration {} could not be untangled; tried the \
              state with the next lowest loss",
@@ -266,7 +266,7 @@ fn write_outputs(
         .collect();
     roar_io::write_mesh_and_files(output, out_soup, &roar_io::WriteOptions::default(), &others)?;
     if let (Some(preview), Some(input)) = (&args.preview, input_soup) {
-        let losses: Vec<f64> = report.run.history.iter().map(|r| r.loss).collect();
+        let losses: Vec<f64> = report.run.optimize.history.iter().map(|r| r.loss).collect();
         crate::preview::write_preview(
             preview,
             input,
@@ -314,7 +314,7 @@ fn run_sdf(
         roar_sdf::load_sdf(input).map_err(|e| anyhow::anyhow!("{}: {e}", input.display()))?;
     check_resources(&config, 0, args.force)?;
     let bounds = args.bounds.unwrap_or(DEFAULT_BOUNDS);
-    let mut progress = Progress::new(args.quiet, config.iterations);
+    let mut progress = Progress::new(args.quiet, config.optimize.iterations);
     let mut shape = SdfShape::new(file_name(input), field.clone(), bounds, &config);
     let mut reconstruction = Reconstruction::new(config.clone());
     let result = reconstruction
@@ -370,18 +370,8 @@ pub fn read_config(
     };
     let text =
         std::fs::read_to_string(path).with_context(|| format!("cannot read {}", path.display()))?;
-    let one_line = |e: toml::de::Error| {
-        anyhow::anyhow!("{}: {}", path.display(), e.to_string().replace('\n', " "))
-    };
-    // Parsed alone first, so unknown keys and bad values are named against the file.
-    let file: ReconstructConfig = toml::from_str(&text).map_err(one_line)?;
-    if defaults == ReconstructConfig::default() {
-        return Ok(file);
-    }
-    // The file's keys over other defaults (an SDF input's schedule).
-    let mut table = toml::Table::try_from(&defaults)?;
-    table.extend(toml::from_str::<toml::Table>(&text).map_err(one_line)?);
-    table.try_into().map_err(one_line)
+    ReconstructConfig::from_toml(&text, &defaults)
+        .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))
 }
 
 /// Defaults, then the TOML file, then the flags.
@@ -397,34 +387,34 @@ pub fn effective_config(args: &ReconstructArgs) -> anyhow::Result<ReconstructCon
         config.faces = faces;
     }
     if let Some(init) = &args.init {
-        config.init = if init == "sphere" {
+        config.init.kind = if init == "sphere" {
             InitKind::Sphere
         } else {
             InitKind::Watertight
         };
     }
     if args.no_icp {
-        config.scan_icp = false;
+        config.target.scan_icp = false;
     }
     if let Some(iterations) = args.iterations {
-        config.iterations = iterations;
+        config.optimize.iterations = iterations;
     }
     if let Some(resolution) = args.resolution {
-        if config.init == InitKind::Sphere {
+        if config.init.kind == InitKind::Sphere {
             anyhow::bail!(
                 "--resolution sets the watertight init's voxels; it has no effect with --init sphere"
             );
         }
-        config.init_resolution = resolution;
+        config.init.init_resolution = resolution;
     }
     if let Some(seed) = args.seed {
         config.seed = seed;
     }
     if args.best_effort {
-        config.best_effort = true;
+        config.finish.best_effort = true;
     }
     if args.keep_topology {
-        config.keep_topology = true;
+        config.finish.keep_topology = true;
     }
     Ok(config)
 }
@@ -525,9 +515,9 @@ fn check_resources(
     let needed = crate::budget::estimated_peak_bytes(&crate::budget::RunSizes {
         working_faces: config.working_budget(),
         input_faces,
-        render_pixels: (config.views_per_axis * config.views_per_axis) as u64
-            * u64::from(config.render_resolution).pow(2),
-        cloud_samples: config.point_cloud_samples,
+        render_pixels: (config.target.views_per_axis * config.target.views_per_axis) as u64
+            * u64::from(config.target.render_resolution).pow(2),
+        cloud_samples: config.target.point_cloud_samples,
     });
     let Some(available) = crate::budget::available_memory_bytes() else {
         return Ok(());

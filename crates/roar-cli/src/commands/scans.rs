@@ -47,7 +47,7 @@ pub fn run(args: &ScansArgs) -> anyhow::Result<()> {
         "{}: not a scan set (name a .conf file or the folder holding one)",
         args.input.display()
     );
-    let scans = load_scans(&args.input, &config, config.scan_icp && !args.no_icp)?;
+    let scans = load_scans(&args.input, &config, config.target.scan_icp && !args.no_icp)?;
     let union = scans.union();
     roar_io::write_mesh(&args.output, &union)?;
     for scan in scans.reports.iter().filter(|s| !s.overlaps) {

@@ -15,8 +15,10 @@ pub enum InitKind {
     Sphere,
 }
 
-/// Every knob of `roar reconstruct`. Where a field's doc names its default (or `docs/method.md`
-/// does), the unit test `documented_defaults` checks that the code agrees.
+/// Every knob of `roar reconstruct`, grouped by the pipeline stage that reads it: the TOML file
+/// has the tables `[target]`, `[init]`, `[loss]`, `[optimize]` and `[finish]` (`--print-config`
+/// prints them all). Where a field's doc names its default (or `docs/method.md` does), the unit
+/// test `documented_defaults` checks that the code agrees.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct ReconstructConfig {
@@ -24,10 +26,107 @@ pub struct ReconstructConfig {
     pub faces: usize,
     /// Seed of every random choice (§10: seed 43).
     pub seed: u64,
-    /// Move Vertices iterations (§1.2 step 5: 200 for ShapeNet).
-    pub iterations: usize,
+    /// The target T′ (§3.1): the rig it is rendered with, its point cloud, and how scans and
+    /// signed distances are read into it.
+    pub target: TargetConfig,
+    /// The initial mesh M0 (§4).
+    pub init: InitConfig,
+    /// The loss the loop minimises (§3.2).
+    pub loss: LossConfig,
+    /// The loop (§1.2): Move Vertices and its blocks, at the working budget.
+    pub optimize: OptimizeConfig,
+    /// From the loop's mesh to exactly N faces (§1.2 step 7 and the steps after it).
+    pub finish: FinishConfig,
+}
+
+impl Default for ReconstructConfig {
+    fn default() -> Self {
+        Self {
+            faces: 5000,
+            seed: 43,
+            target: TargetConfig::default(),
+            init: InitConfig::default(),
+            loss: LossConfig::default(),
+            optimize: OptimizeConfig::default(),
+            finish: FinishConfig::default(),
+        }
+    }
+}
+
+/// `[target]`
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct TargetConfig {
+    /// Views per axis of the star rig: n² views (§3.2.1: 6 → 36).
+    pub views_per_axis: usize,
+    /// Render resolution in pixels (§3.2.1: 512).
+    pub render_resolution: u32,
+    /// Keep both twins of a soup face unless one has this many times more pixels (§3.1 a: 80).
+    pub twin_ratio: f64,
+    /// Target point cloud samples (§3.1 b: 200k).
+    pub point_cloud_samples: usize,
+    /// Keep target samples whose winding number at p + 1e-3·n is below this (§3.1 b, OQ-14).
+    pub winding_threshold: f64,
+    /// Target samples on a sheet (a face of T′ whose reversed twin is kept too: an open surface
+    /// or a zero-thickness part) stand off it by this much along their normal, relative to the
+    /// bounding-box diagonal, so the two sides of the closed output each get their own plane
+    /// instead of jamming against each other on one (0 = off). [INF] Not in the paper; the
+    /// value is the offset CGAL's alpha wrap is run with in the evaluation (`roar_loss::
+    /// point_cloud` explains the jam; at 5000 faces the normal cosine rose on every sheet of the
+    /// evaluation, the Chamfer distance grew on closely fitted ones: `docs/method.md`, "Sheets get
+    /// one plane per side").
+    pub sheet_offset: f64,
+    /// Sharp-edge samples from the init (§3.1 c: 30k).
+    pub sharp_edge_samples: usize,
+    /// Range scans: a patch triangle with an edge longer than this many times the local grid
+    /// spacing bridges a depth jump and is dropped (`roar_io::PatchOptions::max_edge_factor`,
+    /// where the default is measured).
+    pub scan_max_edge_factor: f64,
+    /// Range scans: a patch triangle whose normal is more than this many degrees from the
+    /// direction to the scanner is dropped (`roar_io::PatchOptions::max_angle_degrees`).
+    pub scan_max_angle_degrees: f64,
+    /// Range scans: refine the `.conf` poses by ICP (`roar_ops::align`); `--no-icp` turns it off.
+    pub scan_icp: bool,
+    /// Cells of the grid that brackets the zero set for an SDF input's traced target renders
+    /// (`roar_sdf::trace`): features thinner than about one cell can be missed.
+    pub sdf_trace_grid: usize,
+    /// Regula falsi steps per traced pixel of an SDF input.
+    pub sdf_trace_refine_steps: usize,
+    /// First-order steps of an SDF input's projections: the Face Split projector (§3.4 C: 5)
+    /// and the point-cloud samples.
+    pub sdf_projection_steps: usize,
+    /// A projected sample of an SDF input is valid when its first-order distance `|f|/|∇f|` ends
+    /// at most this, in rig units (§3.4 C: 1e-6 for float64 fields; f32 networks need more).
+    pub sdf_projection_tolerance: f64,
+}
+
+impl Default for TargetConfig {
+    fn default() -> Self {
+        Self {
+            views_per_axis: 6,
+            render_resolution: 512,
+            twin_ratio: 80.0,
+            point_cloud_samples: 200_000,
+            winding_threshold: 0.2,
+            sheet_offset: 1e-3,
+            sharp_edge_samples: 30_000,
+            scan_max_edge_factor: 4.0,
+            scan_max_angle_degrees: 80.0,
+            scan_icp: true,
+            sdf_trace_grid: 128,
+            sdf_trace_refine_steps: 8,
+            sdf_projection_steps: 5,
+            sdf_projection_tolerance: 1e-5,
+        }
+    }
+}
+
+/// `[init]`
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct InitConfig {
     /// Initial mesh (§4).
-    pub init: InitKind,
+    pub kind: InitKind,
     /// Voxels along the longest axis of the watertight init (replaces Manifold's octree
     /// resolution, OQ-12). The init closes gaps of one voxel and the loop never changes the
     /// genus, so this decides which slots and holes of the input survive: 192 keeps gaps down to
@@ -49,19 +148,27 @@ pub struct ReconstructConfig {
     /// Subdivision level of the sphere init. Default 4 (§4.2 has 2; more helps a sphere reach
     /// detail).
     pub sphere_level: u32,
-    /// Working budget W = clamp(factor·N, min, max), never below N (OQ-11, §1.2 step 6).
-    /// Defaults: factor 2, min 5000, max 20 000.
-    pub working_budget_factor: usize,
-    /// Lower bound of the working budget.
-    pub working_budget_min: usize,
-    /// Upper bound of the working budget.
-    pub working_budget_max: usize,
-    /// Views per axis of the star rig: n² views (§3.2.1: 6 → 36).
-    pub views_per_axis: usize,
-    /// Render resolution in pixels (§3.2.1: 512).
-    pub render_resolution: u32,
-    /// Keep both twins of a soup face unless one has this many times more pixels (§3.1 a: 80).
-    pub twin_ratio: f64,
+    /// Cells along the longest side of an SDF input's bounds for its voxel init (§4.3: 64).
+    pub sdf_init_resolution: usize,
+}
+
+impl Default for InitConfig {
+    fn default() -> Self {
+        Self {
+            kind: InitKind::Watertight,
+            init_resolution: 192,
+            init_max_faces: 20_000,
+            enclosure_winding_threshold: 0.0,
+            sphere_level: 4,
+            sdf_init_resolution: 64,
+        }
+    }
+}
+
+/// `[loss]`
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct LossConfig {
     /// λ1, the render loss weight (§3.2.3: 3).
     pub render_weight: f64,
     /// λ2, the planar projection loss weight (§3.2.3: 1).
@@ -78,25 +185,48 @@ pub struct ReconstructConfig {
     pub planar_neighbours: usize,
     /// Include the target-to-source term (OQ-3).
     pub planar_t2s: bool,
-    /// Target point cloud samples (§3.1 b: 200k).
-    pub point_cloud_samples: usize,
-    /// Keep target samples whose winding number at p + 1e-3·n is below this (§3.1 b, OQ-14).
-    pub winding_threshold: f64,
-    /// Target samples on a sheet (a face of T′ whose reversed twin is kept too: an open surface
-    /// or a zero-thickness part) stand off it by this much along their normal, relative to the
-    /// bounding-box diagonal, so the two sides of the closed output each get their own plane
-    /// instead of jamming against each other on one (0 = off). [INF] Not in the paper; the
-    /// value is the offset CGAL's alpha wrap is run with in the evaluation (`roar_loss::
-    /// point_cloud` explains the jam; at 5000 faces the normal cosine rose on every sheet of the
-    /// evaluation, the Chamfer distance grew on closely fitted ones: `docs/method.md`, "Sheets get
-    /// one plane per side").
-    pub sheet_offset: f64,
-    /// Sharp-edge samples from the init (§3.1 c: 30k).
-    pub sharp_edge_samples: usize,
+    /// Weight of the SDF projection loss (§5: 0.1), in the objective only for inputs with a
+    /// signed distance (`roar_loss::SdfLoss`).
+    pub sdf_loss_weight: f64,
+    /// Loop iteration from which the SDF loss is on (§5: 500 of the SDF schedule's 700).
+    pub sdf_loss_start: usize,
+    /// `ε` of the SDF loss's projection `v − f ∇f/(|∇f|² + ε)`.
+    pub sdf_loss_epsilon: f64,
+}
+
+impl Default for LossConfig {
+    fn default() -> Self {
+        Self {
+            render_weight: 3.0,
+            planar_weight: 1.0,
+            planar_scale: 500.0,
+            planar_max_samples: roar_loss::planar::DEFAULT_MAX_SAMPLES,
+            planar_neighbours: 10,
+            planar_t2s: true,
+            sdf_loss_weight: 0.1,
+            sdf_loss_start: 500,
+            sdf_loss_epsilon: 1e-10,
+        }
+    }
+}
+
+/// `[optimize]`
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct OptimizeConfig {
+    /// Move Vertices iterations (§1.2 step 5: 200 for ShapeNet).
+    pub iterations: usize,
     /// Learning rate η (§3.2.4: 0.05).
     pub learning_rate: f64,
     /// Laplacian weight of the optimizer (§8: 0.02).
     pub laplacian_weight: f64,
+    /// Working budget W = clamp(factor·N, min, max), never below N (OQ-11, §1.2 step 6).
+    /// Defaults: factor 2, min 5000, max 20 000.
+    pub working_budget_factor: usize,
+    /// Lower bound of the working budget.
+    pub working_budget_min: usize,
+    /// Upper bound of the working budget.
+    pub working_budget_max: usize,
     /// Face Collapse block and flips every this many iterations (§1.3: 1).
     pub collapse_interval: usize,
     /// Fold estimator slack (§3.6, note 4: 0.6).
@@ -121,26 +251,10 @@ pub struct ReconstructConfig {
     /// 3.05e-3 / 2.16e-3). The triangles are shaped after the final QEM instead
     /// (`final_smoothing_sweeps`).
     pub smoothing_interval: usize,
-    /// Sweeps of tangential smoothing at exactly N after the final QEM, before the polish (default
-    /// 3; 0 = none), each moved vertex put back on its old faces (§3.9 plus projection) and every
-    /// move limited so that no intersection appears. [INF] Not in the paper: with the sweeps off in
-    /// the loop, this is what keeps the output's triangles well shaped. Without it the outputs are
-    /// slightly closer to the input (Chamfer/diag 0.5–1 % lower on gpytoolbox-split_mountain and
-    /// libigl-camelhead at 5000 faces) but worse shaped (median aspect ratio over the 14 wild
-    /// meshes 1.46 with the init at 256 voxels, against 1.26 with the sweeps at 192;
-    /// `docs/method.md`).
-    pub final_smoothing_sweeps: usize,
-    /// Rounds of data-dependent edge flips at exactly N after the smoothing, before the polish
-    /// (default 5; 0 = off): an edge flips when the quad's other diagonal follows the point cloud's
-    /// normals better (`roar_ops::finish::data_flips`), no face gets worse than `Q = 4` (or the
-    /// worse old face) and no intersection appears. [INF] Not in the paper: the valence flips, the
-    /// smoothing and the final QEM choose the diagonals for the triangles' shapes and the working
-    /// mesh's quadrics, not for the target's normals (`docs/method.md`).
-    pub data_flip_rounds: usize,
     /// Every this many iterations, keep a copy of the loop's mesh and its loss (default 10; 0 =
     /// only the last state). The run finishes from the kept state with the lowest loss (the last
-    /// one included) that the untangle block can clear (`run.finished_from_iteration`,
-    /// `run.untangle_failures` in the report). [INF] Not in the paper: the blocks make the loss
+    /// one included) that the untangle block can clear (`run.optimize.finished_from_iteration`,
+    /// `run.optimize.untangle_failures` in the report). [INF] Not in the paper: the blocks make the loss
     /// rise as well as fall, and after it levels off (by iteration 30–50 on the wild meshes at 1000
     /// faces) it can drift up (libigl-camelhead: 0.0486 at iteration 50, 0.0535 at 199); and the
     /// last state may be a tangle the untangle cannot clear.
@@ -158,6 +272,40 @@ pub struct ReconstructConfig {
     /// init of manifoldplus-chair: the collapse, split and smoothing blocks created crossings in
     /// 88, 19 and 28 of their calls, and the run fell back to its init).
     pub guard_intersections: bool,
+    /// The Face Split block of an SDF input projects its samples onto the field (§3.4 C, 6
+    /// gradient evaluations per sample) rather than by the k-NN planar projection over the point
+    /// cloud. The spec's choice and on by default; with a neural field it is most of the run's
+    /// evaluations (`docs/sdf.md`, "Measured cost").
+    pub sdf_split_projector: bool,
+}
+
+impl Default for OptimizeConfig {
+    fn default() -> Self {
+        Self {
+            iterations: 200,
+            learning_rate: 0.05,
+            laplacian_weight: 0.02,
+            working_budget_factor: 2,
+            working_budget_min: 5000,
+            working_budget_max: 20_000,
+            collapse_interval: 1,
+            collapse_fold_slack: 0.6,
+            collapse_min_normal_size: 0.98,
+            split_interval: 10,
+            split_threshold: 0.02,
+            smoothing_interval: 0,
+            checkpoint_interval: 10,
+            step_limiter: true,
+            guard_intersections: false,
+            sdf_split_projector: true,
+        }
+    }
+}
+
+/// `[finish]`
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct FinishConfig {
     /// Separation margin of the untangle block, relative to the bounding-box diagonal.
     pub untangle_margin: f64,
     /// Before the final QEM, move every vertex this far (relative to the bounding-box diagonal)
@@ -169,6 +317,22 @@ pub struct ReconstructConfig {
     /// 5000-face loop mesh to 1000: 5.9 % of the input farther than 1 % of the diagonal from the
     /// output, 0.3 % with an offset of 5e-4).
     pub final_qem_offset: f64,
+    /// Sweeps of tangential smoothing at exactly N after the final QEM, before the polish (default
+    /// 3; 0 = none), each moved vertex put back on its old faces (§3.9 plus projection) and every
+    /// move limited so that no intersection appears. [INF] Not in the paper: with the sweeps off in
+    /// the loop, this is what keeps the output's triangles well shaped. Without it the outputs are
+    /// slightly closer to the input (Chamfer/diag 0.5–1 % lower on gpytoolbox-split_mountain and
+    /// libigl-camelhead at 5000 faces) but worse shaped (median aspect ratio over the 14 wild
+    /// meshes 1.46 with the init at 256 voxels, against 1.26 with the sweeps at 192;
+    /// `docs/method.md`).
+    pub final_smoothing_sweeps: usize,
+    /// Rounds of data-dependent edge flips at exactly N after the smoothing, before the polish
+    /// (default 5; 0 = off): an edge flips when the quad's other diagonal follows the point cloud's
+    /// normals better (`roar_ops::finish::data_flips`), no face gets worse than `Q = 4` (or the
+    /// worse old face) and no intersection appears. [INF] Not in the paper: the valence flips, the
+    /// smoothing and the final QEM choose the diagonals for the triangles' shapes and the working
+    /// mesh's quadrics, not for the target's normals (`docs/method.md`).
+    pub data_flip_rounds: usize,
     /// Move Vertices iterations at exactly N after the final QEM (default 20; 0 = off), with the
     /// step limiter, a learning rate falling linearly to 0 and no blocks, so the face count and
     /// topology stay; the state with the lowest loss is kept. [INF] Not in the paper: the final QEM
@@ -188,104 +352,23 @@ pub struct ReconstructConfig {
     pub sliver_quality: f64,
     /// Write the closest mesh when the final QEM cannot reach the budget, instead of failing.
     pub best_effort: bool,
-    /// Range scans: a patch triangle with an edge longer than this many times the local grid
-    /// spacing bridges a depth jump and is dropped (`roar_io::PatchOptions::max_edge_factor`,
-    /// where the default is measured).
-    pub scan_max_edge_factor: f64,
-    /// Range scans: a patch triangle whose normal is more than this many degrees from the
-    /// direction to the scanner is dropped (`roar_io::PatchOptions::max_angle_degrees`).
-    pub scan_max_angle_degrees: f64,
-    /// Range scans: refine the `.conf` poses by ICP (`roar_ops::align`); `--no-icp` turns it off.
-    pub scan_icp: bool,
     /// Keep the init's genus to the end: when the budget is too small for it (or the final QEM
     /// stalls on the link condition) the run fails with the QEM's named error instead of
     /// removing handles (`roar_ops::finish::genus`; DESIGN.md §2).
     pub keep_topology: bool,
-    /// Weight of the SDF projection loss (§5: 0.1), in the objective only for inputs with a
-    /// signed distance (`roar_loss::SdfLoss`).
-    pub sdf_loss_weight: f64,
-    /// Loop iteration from which the SDF loss is on (§5: 500 of the SDF schedule's 700).
-    pub sdf_loss_start: usize,
-    /// `ε` of the SDF loss's projection `v − f ∇f/(|∇f|² + ε)`.
-    pub sdf_loss_epsilon: f64,
-    /// Cells along the longest side of an SDF input's bounds for its voxel init (§4.3: 64).
-    pub sdf_init_resolution: usize,
-    /// Cells of the grid that brackets the zero set for an SDF input's traced target renders
-    /// (`roar_sdf::trace`): features thinner than about one cell can be missed.
-    pub sdf_trace_grid: usize,
-    /// Regula falsi steps per traced pixel of an SDF input.
-    pub sdf_trace_refine_steps: usize,
-    /// First-order steps of an SDF input's projections: the Face Split projector (§3.4 C: 5)
-    /// and the point-cloud samples.
-    pub sdf_projection_steps: usize,
-    /// The Face Split block of an SDF input projects its samples onto the field (§3.4 C, 6
-    /// gradient evaluations per sample) rather than by the k-NN planar projection over the point
-    /// cloud. The spec's choice and on by default; with a neural field it is most of the run's
-    /// evaluations (`docs/sdf.md`, "Measured cost").
-    pub sdf_split_projector: bool,
-    /// A projected sample of an SDF input is valid when its first-order distance `|f|/|∇f|` ends
-    /// at most this, in rig units (§3.4 C: 1e-6 for float64 fields; f32 networks need more).
-    pub sdf_projection_tolerance: f64,
 }
 
-impl Default for ReconstructConfig {
+impl Default for FinishConfig {
     fn default() -> Self {
         Self {
-            faces: 5000,
-            seed: 43,
-            iterations: 200,
-            init: InitKind::Watertight,
-            init_resolution: 192,
-            init_max_faces: 20_000,
-            enclosure_winding_threshold: 0.0,
-            sphere_level: 4,
-            working_budget_factor: 2,
-            working_budget_min: 5000,
-            working_budget_max: 20_000,
-            views_per_axis: 6,
-            render_resolution: 512,
-            twin_ratio: 80.0,
-            render_weight: 3.0,
-            planar_weight: 1.0,
-            planar_scale: 500.0,
-            planar_max_samples: roar_loss::planar::DEFAULT_MAX_SAMPLES,
-            planar_neighbours: 10,
-            planar_t2s: true,
-            point_cloud_samples: 200_000,
-            winding_threshold: 0.2,
-            sheet_offset: 1e-3,
-            sharp_edge_samples: 30_000,
-            learning_rate: 0.05,
-            laplacian_weight: 0.02,
-            collapse_interval: 1,
-            collapse_fold_slack: 0.6,
-            collapse_min_normal_size: 0.98,
-            split_interval: 10,
-            split_threshold: 0.02,
-            smoothing_interval: 0,
-            final_smoothing_sweeps: 3,
-            data_flip_rounds: 5,
-            checkpoint_interval: 10,
-            step_limiter: true,
-            guard_intersections: false,
             untangle_margin: 1e-6,
             final_qem_offset: 5e-4,
+            final_smoothing_sweeps: 3,
+            data_flip_rounds: 5,
             polish_iterations: 20,
             sliver_quality: 10.0,
             best_effort: false,
-            scan_max_edge_factor: 4.0,
-            scan_max_angle_degrees: 80.0,
-            scan_icp: true,
             keep_topology: false,
-            sdf_loss_weight: 0.1,
-            sdf_loss_start: 500,
-            sdf_loss_epsilon: 1e-10,
-            sdf_init_resolution: 64,
-            sdf_trace_grid: 128,
-            sdf_trace_refine_steps: 8,
-            sdf_projection_steps: 5,
-            sdf_split_projector: true,
-            sdf_projection_tolerance: 1e-5,
         }
     }
 }
@@ -294,28 +377,29 @@ impl ReconstructConfig {
     /// The SDF schedule of spec §5, the defaults for signed distance inputs: the full pipeline
     /// with 700 iterations and 50k faces, the SDF loss on from iteration 500.
     pub fn sdf_defaults() -> Self {
-        Self {
+        let mut config = Self {
             faces: 50_000,
-            iterations: 700,
             ..Self::default()
-        }
+        };
+        config.optimize.iterations = 700;
+        config
     }
 
     /// The defaults for a set of range scans: the soup's, with the init's enclosure rule on at
     /// [`crate::pipeline::scans::SCAN_ENCLOSURE_WINDING_THRESHOLD`], since a scanned object is
     /// closed but the scanner never sees all of it (the bunny's base).
     pub fn scan_defaults() -> Self {
-        Self {
-            enclosure_winding_threshold: crate::pipeline::scans::SCAN_ENCLOSURE_WINDING_THRESHOLD,
-            ..Self::default()
-        }
+        let mut config = Self::default();
+        config.init.enclosure_winding_threshold =
+            crate::pipeline::scans::SCAN_ENCLOSURE_WINDING_THRESHOLD;
+        config
     }
 
     /// W = clamp(factor·N, min, max), never below N (DESIGN.md §2).
     pub fn working_budget(&self) -> usize {
-        let w = (self.working_budget_factor * self.faces)
-            .max(self.working_budget_min)
-            .min(self.working_budget_max)
+        let w = (self.optimize.working_budget_factor * self.faces)
+            .max(self.optimize.working_budget_min)
+            .min(self.optimize.working_budget_max)
             .max(self.faces);
         w + w % 2
     }
@@ -335,13 +419,42 @@ impl ReconstructConfig {
                 ));
             }
         }
-        if self.working_budget_min > self.working_budget_max {
+        if self.optimize.working_budget_min > self.optimize.working_budget_max {
             return Err(format!(
-                "working_budget_min = {} is above working_budget_max = {}",
-                self.working_budget_min, self.working_budget_max
+                "optimize.working_budget_min = {} is above optimize.working_budget_max = {}",
+                self.optimize.working_budget_min, self.optimize.working_budget_max
             ));
         }
         Ok(())
+    }
+
+    /// The config of a TOML file: `defaults` with the file's keys over them, table by table.
+    /// Errors are one line: a key of another table (or a flat key of the ungrouped layout) names
+    /// the table it belongs in, a bad value its line. Does not [`validate`](Self::validate).
+    pub fn from_toml(text: &str, defaults: &Self) -> Result<Self, String> {
+        let one_line = |e: toml::de::Error| e.to_string().replace('\n', " ").trim().to_string();
+        let file: toml::Table = toml::from_str(text).map_err(one_line)?;
+        check_layout(&file)?;
+        // Parsed alone, so a bad value is named with its line in the file.
+        toml::from_str::<Self>(text).map_err(one_line)?;
+        Self::from_table(file, defaults)
+    }
+
+    /// Like [`from_toml`](Self::from_toml) for a table already parsed (the Python package's dict).
+    pub fn from_table(file: toml::Table, defaults: &Self) -> Result<Self, String> {
+        check_layout(&file)?;
+        let mut merged = toml::Table::try_from(defaults).map_err(|e| e.to_string())?;
+        for (key, value) in file {
+            match (merged.get_mut(&key), value) {
+                (Some(toml::Value::Table(table)), toml::Value::Table(keys)) => table.extend(keys),
+                (_, value) => {
+                    merged.insert(key, value);
+                }
+            }
+        }
+        merged
+            .try_into()
+            .map_err(|e: toml::de::Error| e.to_string().replace('\n', " ").trim().to_string())
     }
 
     /// Every numeric field with its allowed range and its current value, in declaration order.
@@ -354,122 +467,214 @@ impl ReconstructConfig {
         vec![
             (r("faces", 4.0, 1e9), self.faces as f64),
             (r("seed", 0.0, u64::MAX as f64), self.seed as f64),
-            (r("iterations", 0.0, 1e5), self.iterations as f64),
             (
-                r("init_resolution", 8.0, 1024.0),
-                self.init_resolution as f64,
-            ),
-            (r("init_max_faces", 4.0, 1e7), self.init_max_faces as f64),
-            (
-                off("enclosure_winding_threshold", 0.5, 1.0),
-                self.enclosure_winding_threshold,
-            ),
-            (r("sphere_level", 0.0, 8.0), f64::from(self.sphere_level)),
-            (
-                r("scan_max_edge_factor", 1.0, 1e3),
-                self.scan_max_edge_factor,
+                r("optimize.iterations", 0.0, 1e5),
+                self.optimize.iterations as f64,
             ),
             (
-                r("scan_max_angle_degrees", 1.0, 90.0),
-                self.scan_max_angle_degrees,
+                r("init.init_resolution", 8.0, 1024.0),
+                self.init.init_resolution as f64,
             ),
             (
-                r("working_budget_factor", 1.0, 100.0),
-                self.working_budget_factor as f64,
+                r("init.init_max_faces", 4.0, 1e7),
+                self.init.init_max_faces as f64,
             ),
             (
-                r("working_budget_min", 4.0, 1e7),
-                self.working_budget_min as f64,
+                off("init.enclosure_winding_threshold", 0.5, 1.0),
+                self.init.enclosure_winding_threshold,
             ),
             (
-                r("working_budget_max", 4.0, 1e7),
-                self.working_budget_max as f64,
-            ),
-            (r("views_per_axis", 1.0, 32.0), self.views_per_axis as f64),
-            (
-                r("render_resolution", 16.0, 4096.0),
-                f64::from(self.render_resolution),
-            ),
-            (r("twin_ratio", 1.0, 1e6), self.twin_ratio),
-            (r("render_weight", 0.0, 1e6), self.render_weight),
-            (r("planar_weight", 0.0, 1e6), self.planar_weight),
-            (r("planar_scale", 0.0, 1e9), self.planar_scale),
-            (
-                r("planar_max_samples", 1.0, 1e8),
-                self.planar_max_samples as f64,
+                r("init.sphere_level", 0.0, 8.0),
+                f64::from(self.init.sphere_level),
             ),
             (
-                r("planar_neighbours", 1.0, 100.0),
-                self.planar_neighbours as f64,
+                r("target.scan_max_edge_factor", 1.0, 1e3),
+                self.target.scan_max_edge_factor,
             ),
             (
-                r("point_cloud_samples", 100.0, 5e7),
-                self.point_cloud_samples as f64,
-            ),
-            (r("winding_threshold", 1e-6, 1.0), self.winding_threshold),
-            (r("sheet_offset", 0.0, 0.1), self.sheet_offset),
-            (
-                r("sharp_edge_samples", 0.0, 5e7),
-                self.sharp_edge_samples as f64,
-            ),
-            (r("learning_rate", 1e-9, 10.0), self.learning_rate),
-            (r("laplacian_weight", 0.0, 1e3), self.laplacian_weight),
-            (
-                r("collapse_interval", 0.0, 1e5),
-                self.collapse_interval as f64,
-            ),
-            (r("collapse_fold_slack", 0.0, 1.0), self.collapse_fold_slack),
-            (
-                r("collapse_min_normal_size", 0.0, 1.0),
-                self.collapse_min_normal_size,
-            ),
-            (r("split_interval", 0.0, 1e5), self.split_interval as f64),
-            (r("split_threshold", 0.0, 1e3), self.split_threshold),
-            (
-                r("smoothing_interval", 0.0, 1e5),
-                self.smoothing_interval as f64,
+                r("target.scan_max_angle_degrees", 1.0, 90.0),
+                self.target.scan_max_angle_degrees,
             ),
             (
-                r("final_smoothing_sweeps", 0.0, 1e3),
-                self.final_smoothing_sweeps as f64,
+                r("optimize.working_budget_factor", 1.0, 100.0),
+                self.optimize.working_budget_factor as f64,
             ),
             (
-                r("data_flip_rounds", 0.0, 1e3),
-                self.data_flip_rounds as f64,
+                r("optimize.working_budget_min", 4.0, 1e7),
+                self.optimize.working_budget_min as f64,
             ),
             (
-                r("checkpoint_interval", 0.0, 1e5),
-                self.checkpoint_interval as f64,
-            ),
-            (r("untangle_margin", 0.0, 0.01), self.untangle_margin),
-            (r("final_qem_offset", 0.0, 0.1), self.final_qem_offset),
-            (
-                r("polish_iterations", 0.0, 1e5),
-                self.polish_iterations as f64,
-            ),
-            (off("sliver_quality", 1.0, 1e6), self.sliver_quality),
-            (r("sdf_loss_weight", 0.0, 1e6), self.sdf_loss_weight),
-            (r("sdf_loss_start", 0.0, 1e5), self.sdf_loss_start as f64),
-            (r("sdf_loss_epsilon", 0.0, 1.0), self.sdf_loss_epsilon),
-            (
-                r("sdf_init_resolution", 2.0, 1024.0),
-                self.sdf_init_resolution as f64,
-            ),
-            (r("sdf_trace_grid", 2.0, 2048.0), self.sdf_trace_grid as f64),
-            (
-                r("sdf_trace_refine_steps", 0.0, 100.0),
-                self.sdf_trace_refine_steps as f64,
+                r("optimize.working_budget_max", 4.0, 1e7),
+                self.optimize.working_budget_max as f64,
             ),
             (
-                r("sdf_projection_steps", 1.0, 100.0),
-                self.sdf_projection_steps as f64,
+                r("target.views_per_axis", 1.0, 32.0),
+                self.target.views_per_axis as f64,
             ),
             (
-                r("sdf_projection_tolerance", 1e-12, 1.0),
-                self.sdf_projection_tolerance,
+                r("target.render_resolution", 16.0, 4096.0),
+                f64::from(self.target.render_resolution),
+            ),
+            (r("target.twin_ratio", 1.0, 1e6), self.target.twin_ratio),
+            (r("loss.render_weight", 0.0, 1e6), self.loss.render_weight),
+            (r("loss.planar_weight", 0.0, 1e6), self.loss.planar_weight),
+            (r("loss.planar_scale", 0.0, 1e9), self.loss.planar_scale),
+            (
+                r("loss.planar_max_samples", 1.0, 1e8),
+                self.loss.planar_max_samples as f64,
+            ),
+            (
+                r("loss.planar_neighbours", 1.0, 100.0),
+                self.loss.planar_neighbours as f64,
+            ),
+            (
+                r("target.point_cloud_samples", 100.0, 5e7),
+                self.target.point_cloud_samples as f64,
+            ),
+            (
+                r("target.winding_threshold", 1e-6, 1.0),
+                self.target.winding_threshold,
+            ),
+            (r("target.sheet_offset", 0.0, 0.1), self.target.sheet_offset),
+            (
+                r("target.sharp_edge_samples", 0.0, 5e7),
+                self.target.sharp_edge_samples as f64,
+            ),
+            (
+                r("optimize.learning_rate", 1e-9, 10.0),
+                self.optimize.learning_rate,
+            ),
+            (
+                r("optimize.laplacian_weight", 0.0, 1e3),
+                self.optimize.laplacian_weight,
+            ),
+            (
+                r("optimize.collapse_interval", 0.0, 1e5),
+                self.optimize.collapse_interval as f64,
+            ),
+            (
+                r("optimize.collapse_fold_slack", 0.0, 1.0),
+                self.optimize.collapse_fold_slack,
+            ),
+            (
+                r("optimize.collapse_min_normal_size", 0.0, 1.0),
+                self.optimize.collapse_min_normal_size,
+            ),
+            (
+                r("optimize.split_interval", 0.0, 1e5),
+                self.optimize.split_interval as f64,
+            ),
+            (
+                r("optimize.split_threshold", 0.0, 1e3),
+                self.optimize.split_threshold,
+            ),
+            (
+                r("optimize.smoothing_interval", 0.0, 1e5),
+                self.optimize.smoothing_interval as f64,
+            ),
+            (
+                r("finish.final_smoothing_sweeps", 0.0, 1e3),
+                self.finish.final_smoothing_sweeps as f64,
+            ),
+            (
+                r("finish.data_flip_rounds", 0.0, 1e3),
+                self.finish.data_flip_rounds as f64,
+            ),
+            (
+                r("optimize.checkpoint_interval", 0.0, 1e5),
+                self.optimize.checkpoint_interval as f64,
+            ),
+            (
+                r("finish.untangle_margin", 0.0, 0.01),
+                self.finish.untangle_margin,
+            ),
+            (
+                r("finish.final_qem_offset", 0.0, 0.1),
+                self.finish.final_qem_offset,
+            ),
+            (
+                r("finish.polish_iterations", 0.0, 1e5),
+                self.finish.polish_iterations as f64,
+            ),
+            (
+                off("finish.sliver_quality", 1.0, 1e6),
+                self.finish.sliver_quality,
+            ),
+            (
+                r("loss.sdf_loss_weight", 0.0, 1e6),
+                self.loss.sdf_loss_weight,
+            ),
+            (
+                r("loss.sdf_loss_start", 0.0, 1e5),
+                self.loss.sdf_loss_start as f64,
+            ),
+            (
+                r("loss.sdf_loss_epsilon", 0.0, 1.0),
+                self.loss.sdf_loss_epsilon,
+            ),
+            (
+                r("init.sdf_init_resolution", 2.0, 1024.0),
+                self.init.sdf_init_resolution as f64,
+            ),
+            (
+                r("target.sdf_trace_grid", 2.0, 2048.0),
+                self.target.sdf_trace_grid as f64,
+            ),
+            (
+                r("target.sdf_trace_refine_steps", 0.0, 100.0),
+                self.target.sdf_trace_refine_steps as f64,
+            ),
+            (
+                r("target.sdf_projection_steps", 1.0, 100.0),
+                self.target.sdf_projection_steps as f64,
+            ),
+            (
+                r("target.sdf_projection_tolerance", 1e-12, 1.0),
+                self.target.sdf_projection_tolerance,
             ),
         ]
     }
+}
+
+/// Refuses a key outside the table it belongs in, naming that table: the flat keys of the
+/// ungrouped layout (`render_weight = 3` at the top) and keys under the wrong table.
+fn check_layout(file: &toml::Table) -> Result<(), String> {
+    let layout = toml::Table::try_from(ReconstructConfig::default()).map_err(|e| e.to_string())?;
+    let home = |key: &str| {
+        layout.iter().find_map(|(table, value)| match value {
+            toml::Value::Table(leaves) if leaves.contains_key(key) => Some(table.as_str()),
+            _ => None,
+        })
+    };
+    let misplaced = |key: &str, here: &str| -> Result<(), String> {
+        if key == "init" {
+            return Err(format!(
+                "`init` {here}: the initial mesh's kind is `kind` in the [init] table"
+            ));
+        }
+        match home(key) {
+            Some(table) => Err(format!(
+                "`{key}` {here}: it belongs in the [{table}] table (write it under [{table}])"
+            )),
+            None => Ok(()),
+        }
+    };
+    for (key, value) in file {
+        match (layout.get(key), value) {
+            (Some(toml::Value::Table(_)), toml::Value::Table(keys)) => {
+                for leaf in keys.keys() {
+                    if !layout[key].as_table().is_some_and(|t| t.contains_key(leaf)) {
+                        misplaced(leaf, &format!("is not a key of [{key}]"))?;
+                    }
+                }
+            }
+            (Some(toml::Value::Table(_)), _) | (None, _) => {
+                misplaced(key, "is not a top-level key")?;
+            }
+            _ => {}
+        }
+    }
+    Ok(())
 }
 
 /// The values a numeric configuration field may take: `min ..= max`, and 0 as well where 0
@@ -525,49 +730,118 @@ impl FieldRange {
 mod tests {
     use super::*;
 
+    /// `--print-config`'s text reads back to the same config, its tables in stage order.
+    #[test]
+    fn printed_layout_reads_back() {
+        let defaults = ReconstructConfig::default();
+        let text = toml::to_string(&defaults).unwrap();
+        let tables: Vec<&str> = text.lines().filter(|l| l.starts_with('[')).collect();
+        assert_eq!(
+            tables,
+            ["[target]", "[init]", "[loss]", "[optimize]", "[finish]"]
+        );
+        assert_eq!(
+            ReconstructConfig::from_toml(&text, &defaults).unwrap(),
+            defaults
+        );
+    }
+
+    /// A file's table changes only the keys it names: the rest of that table keeps the
+    /// defaults it is read over (here the SDF schedule's 700 iterations).
+    #[test]
+    fn file_keys_go_over_the_defaults_key_by_key() {
+        let sdf = ReconstructConfig::sdf_defaults();
+        let c = ReconstructConfig::from_toml("[optimize]\nlearning_rate = 0.1\n", &sdf).unwrap();
+        assert_eq!(c.optimize.learning_rate, 0.1);
+        assert_eq!(c.optimize.iterations, 700);
+        assert_eq!(c.faces, 50_000);
+        assert_eq!(c.loss, sdf.loss);
+    }
+
+    /// Keys of the ungrouped layout and keys under the wrong table name the table they belong
+    /// in, in one line.
+    #[test]
+    fn misplaced_keys_name_their_table() {
+        let d = ReconstructConfig::default();
+        let refused = |text: &str| ReconstructConfig::from_toml(text, &d).unwrap_err();
+        let e = refused("render_weight = 2.0\n");
+        assert!(e.contains("`render_weight`") && e.contains("[loss]"), "{e}");
+        let e = refused("[loss]\niterations = 3\n");
+        assert!(
+            e.contains("`iterations`") && e.contains("[optimize]"),
+            "{e}"
+        );
+        let e = refused("init = \"sphere\"\n");
+        assert!(e.contains("`kind`") && e.contains("[init]"), "{e}");
+        let e = refused("[finish]\nno_such_key = 1\n");
+        assert!(e.contains("no_such_key"), "{e}");
+        let e = refused("[loss]\nrender_weight = \"three\"\n");
+        assert!(e.contains("line 2"), "{e}");
+        for e in [e, refused("render_weight = 2.0\n")] {
+            assert_eq!(e.lines().count(), 1, "{e}");
+        }
+        let sphere = ReconstructConfig::from_toml("[init]\nkind = \"sphere\"\n", &d).unwrap();
+        assert_eq!(sphere.init.kind, InitKind::Sphere);
+    }
+
     /// The defaults the field docs (and `docs/method.md`) state, so the two cannot drift apart.
     #[test]
     fn documented_defaults() {
         let c = ReconstructConfig::default();
         assert_eq!(c.seed, 43);
-        assert_eq!(c.iterations, 200);
-        assert_eq!(c.init, InitKind::Watertight);
-        assert_eq!(c.init_resolution, 192);
-        assert_eq!(c.init_max_faces, 20_000);
-        assert_eq!(c.enclosure_winding_threshold, 0.0, "off by default");
+        assert_eq!(c.optimize.iterations, 200);
+        assert_eq!(c.init.kind, InitKind::Watertight);
+        assert_eq!(c.init.init_resolution, 192);
+        assert_eq!(c.init.init_max_faces, 20_000);
+        assert_eq!(c.init.enclosure_winding_threshold, 0.0, "off by default");
         assert_eq!(roar_ops::init::ENCLOSURE_WINDING_THRESHOLD, 0.7);
-        assert_eq!(c.sphere_level, 4);
+        assert_eq!(c.init.sphere_level, 4);
         assert_eq!(
             (
-                c.working_budget_factor,
-                c.working_budget_min,
-                c.working_budget_max
+                c.optimize.working_budget_factor,
+                c.optimize.working_budget_min,
+                c.optimize.working_budget_max
             ),
             (2, 5000, 20_000)
         );
-        assert_eq!((c.views_per_axis, c.render_resolution), (6, 512));
-        assert_eq!(c.twin_ratio, 80.0);
-        assert_eq!((c.render_weight, c.planar_weight), (3.0, 1.0));
-        assert_eq!(c.planar_scale, 500.0);
-        assert_eq!(c.planar_max_samples, 50_000);
-        assert_eq!(c.planar_max_samples, roar_loss::planar::DEFAULT_MAX_SAMPLES);
-        assert_eq!(c.planar_neighbours, 10);
-        assert_eq!(c.point_cloud_samples, 200_000);
-        assert_eq!(c.sheet_offset, 1e-3);
-        assert_eq!(c.sharp_edge_samples, 30_000);
-        assert_eq!((c.learning_rate, c.laplacian_weight), (0.05, 0.02));
-        assert_eq!(c.collapse_interval, 1);
-        assert_eq!(c.collapse_fold_slack, 0.6);
-        assert_eq!(c.collapse_min_normal_size, 0.98, "on in the pipeline");
-        assert_eq!((c.split_interval, c.split_threshold), (10, 0.02));
-        assert_eq!(c.smoothing_interval, 0, "off by default");
-        assert_eq!(c.final_smoothing_sweeps, 3);
-        assert_eq!(c.data_flip_rounds, 5);
-        assert_eq!(c.checkpoint_interval, 10);
-        assert!(c.step_limiter);
-        assert!(!c.guard_intersections, "off by default");
-        assert_eq!(c.final_qem_offset, 5e-4);
-        assert_eq!(c.polish_iterations, 20);
-        assert_eq!(c.sliver_quality, 10.0);
+        assert_eq!(
+            (c.target.views_per_axis, c.target.render_resolution),
+            (6, 512)
+        );
+        assert_eq!(c.target.twin_ratio, 80.0);
+        assert_eq!((c.loss.render_weight, c.loss.planar_weight), (3.0, 1.0));
+        assert_eq!(c.loss.planar_scale, 500.0);
+        assert_eq!(c.loss.planar_max_samples, 50_000);
+        assert_eq!(
+            c.loss.planar_max_samples,
+            roar_loss::planar::DEFAULT_MAX_SAMPLES
+        );
+        assert_eq!(c.loss.planar_neighbours, 10);
+        assert_eq!(c.target.point_cloud_samples, 200_000);
+        assert_eq!(c.target.sheet_offset, 1e-3);
+        assert_eq!(c.target.sharp_edge_samples, 30_000);
+        assert_eq!(
+            (c.optimize.learning_rate, c.optimize.laplacian_weight),
+            (0.05, 0.02)
+        );
+        assert_eq!(c.optimize.collapse_interval, 1);
+        assert_eq!(c.optimize.collapse_fold_slack, 0.6);
+        assert_eq!(
+            c.optimize.collapse_min_normal_size, 0.98,
+            "on in the pipeline"
+        );
+        assert_eq!(
+            (c.optimize.split_interval, c.optimize.split_threshold),
+            (10, 0.02)
+        );
+        assert_eq!(c.optimize.smoothing_interval, 0, "off by default");
+        assert_eq!(c.finish.final_smoothing_sweeps, 3);
+        assert_eq!(c.finish.data_flip_rounds, 5);
+        assert_eq!(c.optimize.checkpoint_interval, 10);
+        assert!(c.optimize.step_limiter);
+        assert!(!c.optimize.guard_intersections, "off by default");
+        assert_eq!(c.finish.final_qem_offset, 5e-4);
+        assert_eq!(c.finish.polish_iterations, 20);
+        assert_eq!(c.finish.sliver_quality, 10.0);
     }
 }

@@ -33,35 +33,41 @@ pub(super) fn finish(
     run: &mut Run,
 ) -> Result<Mesh, PipelineError> {
     let config = run.config;
-    loss.set_iteration(config.iterations);
+    loss.set_iteration(config.optimize.iterations);
     let faces = states.last().map_or(0, |state| state.mesh.n_faces());
-    run.report("finish", config.iterations, run.stats.loss_last, faces)?;
+    run.report(
+        "finish",
+        config.optimize.iterations,
+        run.stats.optimize.loss_last,
+        faces,
+    )?;
     let mut mesh = finish_from_best_state(states, config, &mut run.stats)?;
     run.clock.lap("untangle");
 
     run.report(
         "decimate",
-        config.iterations,
-        run.stats.loss_last,
+        config.optimize.iterations,
+        run.stats.optimize.loss_last,
         mesh.n_faces(),
     )?;
-    let polishing = config.iterations > 0 && config.polish_iterations > 0;
+    let polishing = config.optimize.iterations > 0 && config.finish.polish_iterations > 0;
     for faces in finish_budgets(mesh.n_faces(), config.faces, polishing) {
         let stats = &mut run.stats;
-        if polishing && config.final_qem_offset > 0.0 {
-            stats.offset_vertices += offset_outward(&mut mesh, config.final_qem_offset);
+        if polishing && config.finish.final_qem_offset > 0.0 {
+            stats.finish.offset_vertices +=
+                offset_outward(&mut mesh, config.finish.final_qem_offset);
             run.clock.lap("offset");
         }
         let decimated = final_decimation(&mut mesh, faces, config, stats)?;
-        stats.final_collapses += decimated.collapses;
+        stats.finish.final_collapses += decimated.collapses;
         run.clock.lap("final_qem");
 
-        if config.iterations > 0 && config.final_smoothing_sweeps > 0 {
+        if config.optimize.iterations > 0 && config.finish.final_smoothing_sweeps > 0 {
             mesh = smooth_if_clean(mesh, normalization, config, stats);
             run.clock.lap("final_smoothing");
         }
 
-        if config.iterations > 0 && config.data_flip_rounds > 0 {
+        if config.optimize.iterations > 0 && config.finish.data_flip_rounds > 0 {
             mesh = flip_toward_cloud_if_clean(mesh, projector, normalization, config, stats);
             run.clock.lap("data_flips");
         }
@@ -70,8 +76,8 @@ pub(super) fn finish(
         if polishing {
             run.report(
                 "polish",
-                config.iterations,
-                run.stats.loss_last,
+                config.optimize.iterations,
+                run.stats.optimize.loss_last,
                 mesh.n_faces(),
             )?;
             mesh = polish(
@@ -85,7 +91,7 @@ pub(super) fn finish(
         }
     }
     drop(loss);
-    if config.iterations > 0 && config.sliver_quality > 0.0 {
+    if config.optimize.iterations > 0 && config.finish.sliver_quality > 0.0 {
         mesh = remove_slivers_if_clean(mesh, normalization, config, &mut run.stats);
         run.clock.lap("sliver_flips");
     }
@@ -111,10 +117,10 @@ fn finish_from_best_state(
         let mut mesh = state.mesh;
         unresolved = fill_and_untangle(&mut mesh, config, stats);
         if unresolved == 0 {
-            stats.finished_from_iteration = state.iteration;
+            stats.optimize.finished_from_iteration = state.iteration;
             return Ok(mesh);
         }
-        stats.untangle_failures.push(UntangleFailure {
+        stats.optimize.untangle_failures.push(UntangleFailure {
             iteration: state.iteration,
             unresolved_faces: unresolved,
         });
@@ -126,22 +132,22 @@ fn finish_from_best_state(
 /// may take the mesh below the budget, and the final QEM never adds faces; splits do not move
 /// any geometry, so no intersection comes back). Returns how many faces it could not clear.
 fn fill_and_untangle(mesh: &mut Mesh, config: &ReconstructConfig, stats: &mut RunStats) -> usize {
-    stats.fill_splits = fill_to_budget(mesh, config.faces);
+    stats.finish.fill_splits = fill_to_budget(mesh, config.faces);
     let untangled = untangle(
         mesh,
         &UntangleOptions {
-            margin_rel: config.untangle_margin,
+            margin_rel: config.finish.untangle_margin,
             ..UntangleOptions::default()
         },
     );
     record_untangle(stats, &untangled);
-    stats.fill_splits += fill_to_budget(mesh, config.faces);
+    stats.finish.fill_splits += fill_to_budget(mesh, config.faces);
     untangled.unresolved_faces.len()
 }
 
 fn record_untangle(stats: &mut RunStats, untangled: &UntangleStats) {
-    stats.untangle_initial_pairs = untangled.initial_pairs;
-    stats.untangle_rounds = untangled.rounds;
+    stats.finish.untangle_initial_pairs = untangled.initial_pairs;
+    stats.finish.untangle_rounds = untangled.rounds;
 }
 
 /// The face counts the finish decimates to, each followed by a polish: `[2N, N]` when the
@@ -173,10 +179,10 @@ fn final_decimation(
     stats: &mut RunStats,
 ) -> Result<DecimateStats, PipelineError> {
     let options = DecimateOptions {
-        best_effort: config.best_effort,
+        best_effort: config.finish.best_effort,
         ..DecimateOptions::default()
     };
-    let decimated = if config.keep_topology {
+    let decimated = if config.finish.keep_topology {
         decimate(mesh, faces, &options)?
     } else {
         let (decimated, removed) = decimate_removing_handles(
@@ -193,10 +199,10 @@ fn final_decimation(
                 handle.loop_vertices, handle.loop_length
             );
         }
-        stats.handles_removed.extend(removed);
+        stats.finish.handles_removed.extend(removed);
         decimated
     };
-    if mesh.n_faces() != faces && !config.best_effort {
+    if mesh.n_faces() != faces && !config.finish.best_effort {
         return Err(PipelineError::Internal(format!(
             "the output has {} faces instead of {}",
             mesh.n_faces(),
@@ -221,11 +227,11 @@ fn smooth_if_clean(
         ..SmoothingOptions::default()
     };
     let (mesh, moves) = keep_if_clean(mesh, normalization, |smoothed| {
-        (0..config.final_smoothing_sweeps)
+        (0..config.finish.final_smoothing_sweeps)
             .map(|_| roar_ops::blocks::smoothing::tangential_smoothing(smoothed, &options).accepted)
             .sum()
     });
-    stats.final_smoothing_moves += moves;
+    stats.finish.final_smoothing_moves += moves;
     mesh
 }
 
@@ -246,13 +252,13 @@ fn flip_toward_cloud_if_clean(
             .map(|&(i, _)| cloud.normals()[i as usize])
     };
     let options = DataFlipOptions {
-        max_rounds: config.data_flip_rounds,
+        max_rounds: config.finish.data_flip_rounds,
         ..DataFlipOptions::default()
     };
     let (mesh, flips) = keep_if_clean(mesh, normalization, |flipped| {
         flip_toward_target(flipped, &target_normal, &options).accepted
     });
-    stats.data_flips += flips;
+    stats.finish.data_flips += flips;
     mesh
 }
 
@@ -271,14 +277,14 @@ fn polish(
     stats: &mut RunStats,
     clock: &mut StageClock,
 ) -> Result<Mesh, PipelineError> {
-    let steps = config.polish_iterations;
+    let steps = config.finish.polish_iterations;
     let (mesh, kept) = try_keep_if_clean(mesh, normalization, |polished| {
         let mut current = polished.clone();
         let mut optimizer = new_optimizer(&current, config)?;
         let mut best: Option<(f64, Mesh)> = None;
         for k in 0..steps {
             let mut options = *optimizer.options();
-            options.lr = config.learning_rate * (steps - k) as f64 / steps as f64;
+            options.lr = config.optimize.learning_rate * (steps - k) as f64 / steps as f64;
             optimizer
                 .set_options(options)
                 .map_err(|e| PipelineError::Internal(e.to_string()))?;
@@ -295,7 +301,7 @@ fn polish(
             if best.as_ref().is_none_or(|(l, _)| record.loss < *l) {
                 best = Some((record.loss, before));
             }
-            stats.polish_history.push(record);
+            stats.finish.polish_history.push(record);
         }
         // One change: the mesh became its best state (possibly the state it started from).
         Ok::<_, PipelineError>(best.map_or(0, |(_, best)| {
@@ -304,7 +310,7 @@ fn polish(
         }))
     })?;
     clock.lap("polish_check");
-    stats.polish_kept = kept > 0;
+    stats.finish.polish_kept = kept > 0;
     Ok(mesh)
 }
 
@@ -320,7 +326,7 @@ fn remove_slivers_if_clean(
     stats: &mut RunStats,
 ) -> Mesh {
     let options = SliverOptions {
-        max_quality: config.sliver_quality,
+        max_quality: config.finish.sliver_quality,
         ..SliverOptions::default()
     };
     let (mut flips, mut collapses) = (0, 0);
@@ -335,8 +341,8 @@ fn remove_slivers_if_clean(
         flips + collapses
     });
     if changes > 0 {
-        stats.sliver_flips = flips;
-        stats.degenerate_collapses = collapses;
+        stats.finish.sliver_flips = flips;
+        stats.finish.degenerate_collapses = collapses;
     }
     mesh
 }
@@ -421,7 +427,7 @@ mod tests {
         let mut stats = RunStats::default();
         let config = ReconstructConfig::default();
         let mesh = remove_slivers_if_clean(mesh, &Normalization::IDENTITY, &config, &mut stats);
-        assert_eq!(stats.degenerate_collapses, 1, "{stats:?}");
+        assert_eq!(stats.finish.degenerate_collapses, 1, "{stats:?}");
         mesh.validate().unwrap();
         assert_eq!(mesh.n_faces(), faces);
         assert_eq!(degenerate_faces(&mesh), 0);
@@ -493,8 +499,11 @@ mod tests {
         let unresolved = fill_and_untangle(&mut mesh, &config, &mut stats);
         assert_eq!(unresolved, 0);
         // The mesh started at the budget, so every split refilled a face the untangle removed.
-        assert!(stats.untangle_initial_pairs > 0);
-        assert!(stats.fill_splits > 0, "the untangle collapsed nothing");
+        assert!(stats.finish.untangle_initial_pairs > 0);
+        assert!(
+            stats.finish.fill_splits > 0,
+            "the untangle collapsed nothing"
+        );
         mesh.validate().unwrap();
         assert_eq!(mesh.n_faces(), faces);
         assert!(count_intersecting_faces(&mesh) == 0);
@@ -560,11 +569,11 @@ mod tests {
         };
         let mut stats = RunStats::default();
         let mesh = finish_from_best_state(states, &config, &mut stats).unwrap();
-        assert_eq!(stats.untangle_failures.len(), 1);
-        assert_eq!(stats.untangle_failures[0].iteration, 10);
-        assert!(stats.untangle_failures[0].unresolved_faces > 0);
+        assert_eq!(stats.optimize.untangle_failures.len(), 1);
+        assert_eq!(stats.optimize.untangle_failures[0].iteration, 10);
+        assert!(stats.optimize.untangle_failures[0].unresolved_faces > 0);
         // Of the two clean states with the next lowest loss, the later one.
-        assert_eq!(stats.finished_from_iteration, 30);
+        assert_eq!(stats.optimize.finished_from_iteration, 30);
         assert_eq!(mesh.n_faces(), apart.n_faces());
         assert_eq!(count_intersecting_faces(&mesh), 0);
     }

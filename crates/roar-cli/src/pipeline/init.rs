@@ -15,7 +15,7 @@ pub(super) fn init(shape: &dyn Shape, run: &mut Run) -> Result<(Mesh, PointCloud
     crate::budget::check_budget(
         "faces =",
         config.faces,
-        crate::budget::min_reachable_budget(&mesh.component_genera(), config.keep_topology),
+        crate::budget::min_reachable_budget(&mesh.component_genera(), config.finish.keep_topology),
     )
     .map_err(|e| PipelineError::Config(format!("{e} (for the pieces of the init)")))?;
     run.clock.lap("init");
@@ -28,11 +28,11 @@ pub(super) fn init(shape: &dyn Shape, run: &mut Run) -> Result<(Mesh, PointCloud
             shape.name()
         ))));
     }
-    run.stats.point_cloud = cloud.points.len();
+    run.stats.target.point_cloud = cloud.points.len();
     run.clock.lap("point_cloud");
 
     let budget = config.working_budget();
-    run.stats.working_budget = budget;
+    run.stats.optimize.working_budget = budget;
     if mesh.n_faces() > budget {
         let options = DecimateOptions {
             best_effort: true,
@@ -51,24 +51,24 @@ fn initial_mesh(
     config: &ReconstructConfig,
     stats: &mut RunStats,
 ) -> Result<Mesh, PipelineError> {
-    let mesh = match config.init {
+    let mesh = match config.init.kind {
         InitKind::Watertight => {
             let initial = shape.initial_mesh()?;
-            stats.init_voxel_faces = initial.raw_faces;
-            stats.init_voxels_filled_by_winding = initial.voxels_filled_by_winding;
+            stats.init.init_voxel_faces = initial.raw_faces;
+            stats.init.init_voxels_filled_by_winding = initial.voxels_filled_by_winding;
             initial.mesh
         }
         InitKind::Sphere => {
-            let mut sphere = roar_mesh::shapes::icosphere(config.sphere_level);
+            let mut sphere = roar_mesh::shapes::icosphere(config.init.sphere_level);
             for p in sphere.positions_mut() {
                 *p *= 0.5;
             }
-            stats.init_voxel_faces = sphere.n_faces();
+            stats.init.init_voxel_faces = sphere.n_faces();
             sphere
         }
     };
-    stats.init_faces = mesh.n_faces();
-    stats.init_components = mesh.components().0;
-    stats.init_genus = mesh.genus();
+    stats.init.init_faces = mesh.n_faces();
+    stats.init.init_components = mesh.components().0;
+    stats.init.init_genus = mesh.genus();
     Ok(mesh)
 }

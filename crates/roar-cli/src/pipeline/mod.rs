@@ -47,7 +47,9 @@ use roar_ops::init::InitError;
 use roar_render::{Camera, Image, star_cameras};
 use serde::Serialize;
 
-pub use config::{InitKind, ReconstructConfig};
+pub use config::{
+    FinishConfig, InitConfig, InitKind, LossConfig, OptimizeConfig, ReconstructConfig, TargetConfig,
+};
 pub use scans::{AlignedScans, SCAN_ENCLOSURE_WINDING_THRESHOLD, ScanReport, load_scans};
 pub use sdf::SdfShape;
 pub use soup::SoupShape;
@@ -128,17 +130,35 @@ pub struct Progress {
     pub faces: usize,
 }
 
-/// Summary of one run, for the JSON report.
+/// Summary of one run, for the JSON report, grouped by stage as the config is.
 #[derive(Debug, Clone, Default, Serialize)]
 pub struct RunStats {
     /// Seconds per stage, in first-run order of stage names (sorted by name in JSON).
     pub seconds: BTreeMap<String, f64>,
-    /// Target clean-up figures.
+    /// What the target preparation made (the `[target]` stage).
+    pub target: TargetStats,
+    /// The initial mesh M0 (the `[init]` stage).
+    pub init: InitStats,
+    /// The loop at the working budget (the `[optimize]` stage).
+    pub optimize: OptimizeStats,
+    /// From the loop's mesh to exactly N faces (the `[finish]` stage).
+    pub finish: FinishStats,
+}
+
+/// What the target preparation made (the `[target]` stage).
+#[derive(Debug, Clone, Default, Serialize)]
+pub struct TargetStats {
+    /// Faces of the cleaned target T′.
     pub target_faces: usize,
     /// Twins dropped by the pixel-count rule.
     pub twins_dropped: usize,
     /// Point cloud size (with sharp-edge samples).
     pub point_cloud: usize,
+}
+
+/// The initial mesh M0 (the `[init]` stage).
+#[derive(Debug, Clone, Default, Serialize)]
+pub struct InitStats {
     /// Faces of the voxel surface before any decimation.
     pub init_voxel_faces: usize,
     /// Faces of M0 after QEM to ≤ init_max_faces.
@@ -150,6 +170,11 @@ pub struct RunStats {
     /// Voxels the init's winding-number rule turned solid (punctures closed;
     /// `roar_ops::init::InitOptions::enclosure_winding_threshold`).
     pub init_voxels_filled_by_winding: usize,
+}
+
+/// The loop at the working budget (the `[optimize]` stage).
+#[derive(Debug, Clone, Default, Serialize)]
+pub struct OptimizeStats {
     /// The working budget W.
     pub working_budget: usize,
     /// Loss at the first and last iteration.
@@ -164,8 +189,6 @@ pub struct RunStats {
     pub block_accepted: BTreeMap<&'static str, usize>,
     /// Vertex steps the step limiter shortened or cancelled over the loop.
     pub steps_shortened: usize,
-    /// Edge splits used to fill up to N.
-    pub fill_splits: usize,
     /// Loss of the loop's last state (evaluated once more after the last iteration; NaN, null
     /// in the report, when no checkpoint was kept to compare it with).
     pub loss_of_last_state: f64,
@@ -175,6 +198,11 @@ pub struct RunStats {
     pub finished_from_iteration: usize,
     /// States with a lower loss that the untangle block could not clear, in the order tried.
     pub untangle_failures: Vec<UntangleFailure>,
+}
+
+/// From the loop's mesh to exactly N faces (the `[finish]` stage).
+#[derive(Debug, Clone, Default, Serialize)]
+pub struct FinishStats {
     /// Untangle statistics.
     pub untangle_initial_pairs: usize,
     /// Rounds the untangle block needed.
@@ -182,6 +210,8 @@ pub struct RunStats {
     /// Collapses of the finish's QEMs (to 2N first when the mesh has more faces, see
     /// `finish_budgets`, then to N).
     pub final_collapses: usize,
+    /// Edge splits used to fill up to N.
+    pub fill_splits: usize,
     /// Vertices moved the whole `final_qem_offset` before the finish's QEMs, summed (the others
     /// were shortened or kept where a full move would have made faces intersect).
     pub offset_vertices: usize,
@@ -325,19 +355,19 @@ impl Reconstruction {
 /// `render_resolution²` pixels), for which every shape renders its target.
 pub fn rig_cameras(config: &ReconstructConfig) -> Vec<Camera> {
     star_cameras(
-        config.views_per_axis,
-        config.views_per_axis,
-        config.render_resolution,
-        config.render_resolution,
+        config.target.views_per_axis,
+        config.target.views_per_axis,
+        config.target.render_resolution,
+        config.target.render_resolution,
     )
 }
 
 /// The target renders' options of `config` (spec §3.1, §3.2.1), as the pipeline uses them.
 pub fn target_options(config: &ReconstructConfig) -> TargetOptions {
     TargetOptions {
-        views_per_axis: config.views_per_axis,
-        resolution: config.render_resolution,
-        twin_ratio: config.twin_ratio,
+        views_per_axis: config.target.views_per_axis,
+        resolution: config.target.render_resolution,
+        twin_ratio: config.target.twin_ratio,
     }
 }
 
@@ -345,12 +375,12 @@ pub fn target_options(config: &ReconstructConfig) -> TargetOptions {
 pub fn planar_options(config: &ReconstructConfig) -> PlanarOptions {
     PlanarOptions {
         knn: KnnOptions {
-            k: config.planar_neighbours,
+            k: config.loss.planar_neighbours,
             ..KnnOptions::default()
         },
-        t2s: config.planar_t2s,
-        max_samples: config.planar_max_samples,
-        scale: config.planar_scale,
+        t2s: config.loss.planar_t2s,
+        max_samples: config.loss.planar_max_samples,
+        scale: config.loss.planar_scale,
         seed: config.seed,
         ..PlanarOptions::default()
     }
@@ -367,17 +397,17 @@ pub fn default_loss(prepared: &Prepared) -> Result<Box<dyn Loss>, PipelineError>
     )?;
     let mut sum = WeightedSum::default()
         .with(
-            config.render_weight,
+            config.loss.render_weight,
             Box::new(RenderLoss::from_renders(prepared.cameras, prepared.renders)),
         )
-        .with(config.planar_weight, Box::new(planar));
+        .with(config.loss.planar_weight, Box::new(planar));
     if let Some(sdf) = &prepared.signed_distance {
         let options = SdfLossOptions {
-            start_iteration: config.sdf_loss_start,
-            epsilon: config.sdf_loss_epsilon,
+            start_iteration: config.loss.sdf_loss_start,
+            epsilon: config.loss.sdf_loss_epsilon,
         };
         sum = sum.with(
-            config.sdf_loss_weight,
+            config.loss.sdf_loss_weight,
             Box::new(SdfLoss::new(sdf.clone(), options)),
         );
     }
@@ -390,40 +420,40 @@ pub fn default_blocks(config: &ReconstructConfig) -> Vec<ScheduledBlock> {
         ScheduledBlock {
             block: Box::new(FaceCollapse {
                 options: FaceCollapseOptions {
-                    fold_slack: config.collapse_fold_slack,
-                    min_normal_size: (config.collapse_min_normal_size > 0.0)
-                        .then_some(config.collapse_min_normal_size),
+                    fold_slack: config.optimize.collapse_fold_slack,
+                    min_normal_size: (config.optimize.collapse_min_normal_size > 0.0)
+                        .then_some(config.optimize.collapse_min_normal_size),
                     flips: Some(FlipOptions {
-                        guard_intersections: config.guard_intersections,
+                        guard_intersections: config.optimize.guard_intersections,
                         ..FlipOptions::default()
                     }),
-                    guard_intersections: config.guard_intersections,
+                    guard_intersections: config.optimize.guard_intersections,
                     ..FaceCollapseOptions::default()
                 },
             }),
-            every: config.collapse_interval,
+            every: config.optimize.collapse_interval,
             skip_first: false,
         },
         ScheduledBlock {
             block: Box::new(FaceSplit {
                 options: FaceSplitOptions {
-                    threshold: SplitThreshold::PerSubTriangle(config.split_threshold),
+                    threshold: SplitThreshold::PerSubTriangle(config.optimize.split_threshold),
                     seed: config.seed,
-                    guard_intersections: config.guard_intersections,
+                    guard_intersections: config.optimize.guard_intersections,
                     ..FaceSplitOptions::default()
                 },
             }),
-            every: config.split_interval,
+            every: config.optimize.split_interval,
             skip_first: true,
         },
         ScheduledBlock {
             block: Box::new(TangentialSmoothing {
                 options: SmoothingOptions {
-                    guard_intersections: config.guard_intersections,
+                    guard_intersections: config.optimize.guard_intersections,
                     ..SmoothingOptions::default()
                 },
             }),
-            every: config.smoothing_interval,
+            every: config.optimize.smoothing_interval,
             skip_first: false,
         },
     ]
@@ -461,7 +491,7 @@ impl Run<'_> {
         (self.progress)(&Progress {
             stage,
             iteration,
-            iterations: self.config.iterations,
+            iterations: self.config.optimize.iterations,
             loss,
             faces,
         });

@@ -53,7 +53,7 @@ pub(super) fn objective(
         &cloud.points,
         &cloud.normals,
         &KnnOptions {
-            k: config.planar_neighbours,
+            k: config.loss.planar_neighbours,
             ..KnnOptions::default()
         },
     )?;
@@ -78,9 +78,9 @@ pub(super) fn optimize(
     let mut states: Vec<LoopState> = Vec::new();
     run.clock.lap("loop_setup");
 
-    for iteration in 0..config.iterations {
-        let candidate = (config.checkpoint_interval > 0
-            && iteration % config.checkpoint_interval == 0)
+    for iteration in 0..config.optimize.iterations {
+        let candidate = (config.optimize.checkpoint_interval > 0
+            && iteration % config.optimize.checkpoint_interval == 0)
             .then(|| mesh.clone());
         loss.set_iteration(iteration);
         let record = move_vertices(
@@ -104,10 +104,10 @@ pub(super) fn optimize(
         }
         let stats = &mut run.stats;
         if iteration == 0 {
-            stats.loss_first = value;
+            stats.optimize.loss_first = value;
         }
-        stats.loss_last = value;
-        stats.history.push(record);
+        stats.optimize.loss_last = value;
+        stats.optimize.history.push(record);
         let context = BlockContext {
             iteration,
             face_budget: budget,
@@ -122,6 +122,7 @@ pub(super) fn optimize(
                     .block
                     .apply(&mut TrackedMesh::new(&mut mesh, &mut optimizer), &context);
                 *run.stats
+                    .optimize
                     .block_accepted
                     .entry(block_stats.name)
                     .or_insert(0) += total_accepted(&block_stats);
@@ -131,7 +132,7 @@ pub(super) fn optimize(
         }
         run.report("optimize", iteration, value, mesh.n_faces())?;
     }
-    run.stats.loop_faces = mesh.n_faces();
+    run.stats.optimize.loop_faces = mesh.n_faces();
 
     // The last state's loss decides only when there are other states to compare with.
     let last = if states.is_empty() {
@@ -140,9 +141,9 @@ pub(super) fn optimize(
         let triangles = compact_triangles(&mut mesh, &mut optimizer);
         loss.value_and_grad(mesh.positions(), &triangles)?.0
     };
-    run.stats.loss_of_last_state = last;
+    run.stats.optimize.loss_of_last_state = last;
     states.push(LoopState {
-        iteration: config.iterations,
+        iteration: config.optimize.iterations,
         loss: last,
         mesh,
     });
@@ -165,8 +166,8 @@ pub(super) fn new_optimizer(
     Optimizer::new(
         mesh.vertex_capacity(),
         OptimizerOptions {
-            lr: config.learning_rate,
-            laplacian_weight: config.laplacian_weight,
+            lr: config.optimize.learning_rate,
+            laplacian_weight: config.optimize.laplacian_weight,
             ..OptimizerOptions::default()
         },
     )
@@ -193,7 +194,10 @@ pub(super) fn move_vertices(
         faces: mesh.n_faces(),
     };
     clock.lap(&format!("{stage}_loss"));
-    let before = config.step_limiter.then(|| mesh.positions().to_vec());
+    let before = config
+        .optimize
+        .step_limiter
+        .then(|| mesh.positions().to_vec());
     optimizer
         .step(mesh.positions_mut(), &triangles, &gradient)
         .map_err(|e| PipelineError::Internal(e.to_string()))?;
@@ -205,7 +209,7 @@ pub(super) fn move_vertices(
             &triangles,
             &LimiterOptions::default(),
         );
-        stats.steps_shortened += limited.shortened + limited.cancelled;
+        stats.optimize.steps_shortened += limited.shortened + limited.cancelled;
         clock.lap(&format!("{stage}_step_limiter"));
     }
     Ok(record)

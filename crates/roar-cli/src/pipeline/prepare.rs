@@ -22,8 +22,8 @@ pub(super) fn prepare(shape: &mut dyn Shape, run: &mut Run) -> Result<Target, Pi
     shape.prepare(&cameras)?;
     let normalization = shape.normalization();
     let summary = shape.summary();
-    run.stats.target_faces = summary.target_faces;
-    run.stats.twins_dropped = summary.twins_dropped;
+    run.stats.target.target_faces = summary.target_faces;
+    run.stats.target.twins_dropped = summary.twins_dropped;
     run.clock.lap("target");
     Ok(Target {
         cameras,

@@ -76,8 +76,8 @@ pub fn load_scans(
 ) -> Result<AlignedScans, IoError> {
     let set = roar_io::read_scan_set(path)?;
     let options = PatchOptions {
-        max_edge_factor: config.scan_max_edge_factor,
-        max_angle_degrees: config.scan_max_angle_degrees,
+        max_edge_factor: config.target.scan_max_edge_factor,
+        max_angle_degrees: config.target.scan_max_angle_degrees,
     };
     let mut patches = Vec::with_capacity(set.scans.len());
     let mut reports = Vec::with_capacity(set.scans.len());

@@ -85,8 +85,8 @@ impl SdfShape {
         let projector = SdfProjector {
             sdf: rig.clone(),
             options: SdfProjectorOptions {
-                steps: config.sdf_projection_steps,
-                tolerance: config.sdf_projection_tolerance,
+                steps: config.target.sdf_projection_steps,
+                tolerance: config.target.sdf_projection_tolerance,
             },
         };
         Self {
@@ -133,8 +133,8 @@ impl SdfShape {
 
     fn trace(&self, cameras: &[Camera]) -> Vec<Image> {
         let options = TraceOptions {
-            grid_resolution: self.config.sdf_trace_grid,
-            refine_steps: self.config.sdf_trace_refine_steps,
+            grid_resolution: self.config.target.sdf_trace_grid,
+            refine_steps: self.config.target.sdf_trace_refine_steps,
         };
         let (images, stats) = self.counted("trace", || {
             roar_sdf::trace_normal_maps(self.rig.as_ref(), &self.rig_bounds(), cameras, &options)
@@ -200,7 +200,7 @@ impl Shape for SdfShape {
     fn initial_mesh(&self) -> Result<InitialMesh, ShapeError> {
         let bounds = self.rig_bounds();
         let options = SdfInitOptions {
-            resolution: self.config.sdf_init_resolution,
+            resolution: self.config.init.sdf_init_resolution,
             ..SdfInitOptions::default()
         };
         let init = self
@@ -210,7 +210,7 @@ impl Shape for SdfShape {
             .map_err(|e| ShapeError::Init(format!("{}: {e}", self.name)))?;
         let raw_faces = init.triangles.len();
         let options = InitialMeshOptions {
-            max_faces: self.config.init_max_faces,
+            max_faces: self.config.init.init_max_faces,
             ..InitialMeshOptions::default()
         };
         let (mesh, _) = initial_mesh_from_init(init, 0.0, &options)
@@ -227,15 +227,15 @@ impl Shape for SdfShape {
         let samples = sample_surface(
             &positions,
             &triangles,
-            self.config.point_cloud_samples,
+            self.config.target.point_cloud_samples,
             self.config.seed,
         );
         let (points, normals) = self.counted("point_cloud", || {
             roar_sdf::project_samples(
                 self.rig.as_ref(),
                 samples.points,
-                self.config.sdf_projection_steps,
-                self.config.sdf_projection_tolerance,
+                self.config.target.sdf_projection_steps,
+                self.config.target.sdf_projection_tolerance,
             )
         });
         if points.is_empty() {
@@ -261,6 +261,7 @@ impl Shape for SdfShape {
     /// The field's projector (spec §3.4 C) unless `sdf_split_projector` is off.
     fn projector(&self) -> Option<&dyn Projector> {
         self.config
+            .optimize
             .sdf_split_projector
             .then_some(&self.projector as &dyn Projector)
     }

@@ -96,12 +96,12 @@ impl Shape for SoupShape<'_> {
         let target = self.prepared()?;
         let options = InitialMeshOptions {
             init: InitOptions {
-                resolution: self.config.init_resolution,
-                enclosure_winding_threshold: (self.config.enclosure_winding_threshold > 0.0)
-                    .then_some(self.config.enclosure_winding_threshold),
+                resolution: self.config.init.init_resolution,
+                enclosure_winding_threshold: (self.config.init.enclosure_winding_threshold > 0.0)
+                    .then_some(self.config.init.enclosure_winding_threshold),
                 ..InitOptions::default()
             },
-            max_faces: self.config.init_max_faces,
+            max_faces: self.config.init.init_max_faces,
             ..InitialMeshOptions::default()
         };
         let (mesh, stats) =
@@ -119,18 +119,18 @@ impl Shape for SoupShape<'_> {
         let config = &self.config;
         let diagonal =
             Aabb::from_points(target.positions.iter().copied()).map_or(0.0, |b| b.diagonal());
-        let sheet_offset = config.sheet_offset * diagonal;
+        let sheet_offset = config.target.sheet_offset * diagonal;
         let mut cloud = point_cloud(
             target,
             &PointCloudOptions {
-                samples: config.point_cloud_samples,
-                winding_threshold: config.winding_threshold,
+                samples: config.target.point_cloud_samples,
+                winding_threshold: config.target.winding_threshold,
                 sheet_offset,
                 seed: config.seed,
                 ..PointCloudOptions::default()
             },
         )?;
-        if config.sharp_edge_samples > 0 {
+        if config.target.sharp_edge_samples > 0 {
             let (positions, triangles) = initial.to_triangles();
             let sharp = sharp_edge_samples(
                 &target.bvh(),
@@ -138,7 +138,7 @@ impl Shape for SoupShape<'_> {
                 &positions,
                 &triangles,
                 &SharpEdgeOptions {
-                    samples: config.sharp_edge_samples,
+                    samples: config.target.sharp_edge_samples,
                     sheet_offset,
                     seed: config.seed,
                     ..SharpEdgeOptions::default()

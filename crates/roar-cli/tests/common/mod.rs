@@ -5,23 +5,35 @@
 #[path = "../../../roar-io/tests/common/gltf.rs"]
 pub mod gltf;
 
-use roar_cli::pipeline::ReconstructConfig;
+use roar_cli::pipeline::{InitConfig, LossConfig, OptimizeConfig, ReconstructConfig, TargetConfig};
 
 /// Few views, low resolutions, few iterations (as `reconstruct_small` uses), at `faces`.
 pub fn toy_config(faces: usize, iterations: usize) -> ReconstructConfig {
     ReconstructConfig {
         faces,
-        iterations,
-        init_resolution: 32,
-        init_max_faces: 4000,
-        working_budget_min: 600,
-        views_per_axis: 2,
-        render_resolution: 64,
-        point_cloud_samples: 5000,
-        sharp_edge_samples: 1000,
-        planar_max_samples: 5000,
-        split_interval: 3,
-        smoothing_interval: 2,
+        target: TargetConfig {
+            views_per_axis: 2,
+            render_resolution: 64,
+            point_cloud_samples: 5000,
+            sharp_edge_samples: 1000,
+            ..Default::default()
+        },
+        init: InitConfig {
+            init_resolution: 32,
+            init_max_faces: 4000,
+            ..Default::default()
+        },
+        loss: LossConfig {
+            planar_max_samples: 5000,
+            ..Default::default()
+        },
+        optimize: OptimizeConfig {
+            iterations,
+            working_budget_min: 600,
+            split_interval: 3,
+            smoothing_interval: 2,
+            ..Default::default()
+        },
         ..ReconstructConfig::default()
     }
 }
