@@ -123,7 +123,7 @@ def test_progress_gets_the_cli_records_and_its_exception_stops_the_run():
     for stage in ("target", "init", "optimize", "decimate"):
         assert stage in stages
     optimize = [r for r in records if r["stage"] == "optimize"]
-    assert [r["iteration"] for r in optimize] == list(range(TOY["iterations"]))
+    assert [r["iteration"] for r in optimize] == list(range(TOY["optimize"]["iterations"]))
     assert all(set(r) == {"stage", "iteration", "iterations", "loss", "faces"} for r in records)
 
     class Stop(Exception):
