@@ -110,34 +110,44 @@ pub fn silhouette_masks(
     triangles: &[[u32; 3]],
     neighbors: &EdgeNeighbors,
 ) -> Vec<u8> {
+    silhouettes_and_orientations(verts, triangles, neighbors).0
+}
+
+/// [`silhouette_masks`], and per face and edge `k` the edge function of edge `k` at the third
+/// corner (`edge_fn(c_k, c_{k+1}, c_{k+2})`, the face's signed doubled area in screen space,
+/// computed per edge), which the pair walk reads instead of computing it again per step.
+fn silhouettes_and_orientations(
+    verts: &[ProjectedVertex],
+    triangles: &[[u32; 3]],
+    neighbors: &EdgeNeighbors,
+) -> (Vec<u8>, Vec<[f64; 3]>) {
     let xy = |v: u32| {
         let v = &verts[v as usize];
         [v.x, v.y]
     };
-    triangles
-        .iter()
-        .zip(&neighbors.opposite)
-        .map(|(tri, opposite)| {
-            // Each corner is read once for the three edges.
-            let corner = tri.map(xy);
-            let mut mask = 0u8;
-            for k in 0..3 {
-                let silhouette = if opposite[k] == NO_NEIGHBOR {
-                    true
-                } else {
-                    let a = corner[k];
-                    let b = corner[(k + 1) % 3];
-                    let own = edge_fn(a, b, corner[(k + 2) % 3]);
-                    let other = edge_fn(a, b, xy(opposite[k]));
-                    own * other >= 0.0
-                };
-                if silhouette {
-                    mask |= 1 << k;
-                }
+    let mut masks = Vec::with_capacity(triangles.len());
+    let mut orientations = Vec::with_capacity(triangles.len());
+    for (tri, opposite) in triangles.iter().zip(&neighbors.opposite) {
+        // Each corner is read once for the three edges.
+        let corner = tri.map(xy);
+        let mut mask = 0u8;
+        let mut own = [0.0; 3];
+        for k in 0..3 {
+            let a = corner[k];
+            let b = corner[(k + 1) % 3];
+            own[k] = edge_fn(a, b, corner[(k + 2) % 3]);
+            let silhouette = opposite[k] == NO_NEIGHBOR || {
+                let other = edge_fn(a, b, xy(opposite[k]));
+                own[k] * other >= 0.0
+            };
+            if silhouette {
+                mask |= 1 << k;
             }
-            mask
-        })
-        .collect()
+        }
+        masks.push(mask);
+        orientations.push(own);
+    }
+    (masks, orientations)
 }
 
 /// Finds the antialiasing items of one view. Items come in a deterministic order (horizontal
@@ -155,7 +165,7 @@ pub fn antialias_items(
     if w == 0 || ids.len() != w * height as usize {
         return Vec::new();
     }
-    let masks = silhouette_masks(verts, triangles, neighbors);
+    let (masks, orientations) = silhouettes_and_orientations(verts, triangles, neighbors);
     let mut items = Vec::new();
     let ctx = PairContext {
         verts,
@@ -163,8 +173,8 @@ pub fn antialias_items(
         neighbors,
         ids,
         depth,
-        width,
         masks: &masks,
+        orientations: &orientations,
     };
     // Most differing pairs see two faces joined by a non-silhouette edge (the same smooth
     // surface); `pair` would return nothing for them whichever face is in front, so they are
@@ -173,7 +183,7 @@ pub fn antialias_items(
     for (y, row) in ids.chunks_exact(w).enumerate() {
         for_each_differing(row, &row[1..], |x| {
             if !smooth(row[x], row[x + 1])
-                && let Some(item) = ctx.pair(y * w + x, y * w + x + 1, true)
+                && let Some(item) = ctx.pair(y * w + x, [x, y], true, w)
             {
                 items.push(item);
             }
@@ -182,7 +192,7 @@ pub fn antialias_items(
     let horizontal = items.len();
     for_each_differing(ids, &ids[w.min(ids.len())..], |p| {
         if !smooth(ids[p], ids[p + w])
-            && let Some(item) = ctx.pair(p, p + w, false)
+            && let Some(item) = ctx.pair(p, [p % w, p / w], false, w)
         {
             items.push(item);
         }
@@ -260,8 +270,9 @@ struct PairContext<'a> {
     neighbors: &'a EdgeNeighbors,
     ids: &'a [u32],
     depth: &'a [f32],
-    width: u32,
     masks: &'a [u8],
+    /// Per face, [`silhouettes_and_orientations`]' edge functions at the third corners.
+    orientations: &'a [[f64; 3]],
 }
 
 impl PairContext<'_> {
@@ -281,7 +292,14 @@ impl PairContext<'_> {
         (0..3).any(|k| adjacent[k] == b && mask & (1 << k) == 0)
     }
 
-    fn pair(&self, p: usize, q: usize, horizontal: bool) -> Option<AaItem> {
+    /// The item of pixel `p` at `p_xy` and its right (`horizontal`) or lower neighbour in an
+    /// image `w` wide, if the pair straddles a silhouette.
+    fn pair(&self, p: usize, p_xy: [usize; 2], horizontal: bool, w: usize) -> Option<AaItem> {
+        let (q, q_xy) = if horizontal {
+            (p + 1, [p_xy[0] + 1, p_xy[1]])
+        } else {
+            (p + w, [p_xy[0], p_xy[1] + 1])
+        };
         let (fp, fq) = (self.ids[p], self.ids[q]);
         let p_in_front = if fp == BACKGROUND {
             false
@@ -291,7 +309,11 @@ impl PairContext<'_> {
             let (dp, dq) = (self.depth[p], self.depth[q]);
             dp < dq || (dp == dq && self.triangles[fp as usize] < self.triangles[fq as usize])
         };
-        let (front, other) = if p_in_front { (p, q) } else { (q, p) };
+        let ((front, front_xy), (other, other_xy)) = if p_in_front {
+            ((p, p_xy), (q, q_xy))
+        } else {
+            ((q, q_xy), (p, p_xy))
+        };
         let face = self.ids[front];
         let mask = self.masks[face as usize];
         // Exit for the interior case: the other pixel sees the neighbour across a
@@ -299,8 +321,9 @@ impl PairContext<'_> {
         if self.smooth_across(face, self.ids[other]) {
             return None;
         }
-        let cf = pixel_centre(front as u32, self.width);
-        let co = pixel_centre(other as u32, self.width);
+        // `pixel_centre` of the two pixels, from their coordinates (the same values).
+        let centre = |[x, y]: [usize; 2]| [x as f64 + 0.5, y as f64 + 0.5];
+        let (cf, co) = (centre(front_xy), centre(other_xy));
         // Follow the segment front → other through the front surface: leave the front triangle
         // through the first edge its edge function falls below zero on; if that edge is not a
         // silhouette, continue in the neighbour across it (a fan around a vertex), up to a few
@@ -311,11 +334,12 @@ impl PairContext<'_> {
         for _ in 0..MAX_WALK {
             let tri = self.triangles[face as usize];
             let corner = tri.map(|v| self.xy(v));
+            let orientation = self.orientations[face as usize];
             let mut best: Option<(usize, f64)> = None;
             for k in 0..3 {
                 let a = corner[k];
                 let b = corner[(k + 1) % 3];
-                let orient = edge_fn(a, b, corner[(k + 2) % 3]);
+                let orient = orientation[k];
                 let (ef, eo) = (edge_fn(a, b, cf) * orient, edge_fn(a, b, co) * orient);
                 if ef > eo {
                     let t = ef / (ef - eo);
@@ -365,6 +389,46 @@ impl PairContext<'_> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn orientations_are_the_edge_functions_at_the_third_corners() {
+        // Random screen vertices, a strip of triangles sharing edges (so some edges have a
+        // neighbour and some fold back), plus a lone triangle and a degenerate one.
+        let mut state = 0x9e37_79b9_7f4a_7c15u64;
+        let mut next = || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 11) as f64 / (1u64 << 53) as f64 * 512.0
+        };
+        let verts: Vec<ProjectedVertex> = (0..40)
+            .map(|_| ProjectedVertex {
+                x: next(),
+                y: next(),
+                z: 0.5,
+                cx: 0.0,
+                cy: 0.0,
+                w: 1.0,
+            })
+            .collect();
+        let mut triangles: Vec<[u32; 3]> = (0..30).map(|i| [i, i + 1, i + 2]).collect();
+        triangles.push([35, 36, 37]);
+        triangles.push([38, 38, 39]);
+        let neighbors = EdgeNeighbors::new(&triangles);
+        let (masks, orientations) = silhouettes_and_orientations(&verts, &triangles, &neighbors);
+        assert_eq!(masks, silhouette_masks(&verts, &triangles, &neighbors));
+        let xy = |v: u32| [verts[v as usize].x, verts[v as usize].y];
+        for (tri, orientation) in triangles.iter().zip(&orientations) {
+            for k in 0..3 {
+                let expected = edge_fn(xy(tri[k]), xy(tri[(k + 1) % 3]), xy(tri[(k + 2) % 3]));
+                assert_eq!(
+                    orientation[k].to_bits(),
+                    expected.to_bits(),
+                    "{tri:?} edge {k}"
+                );
+            }
+        }
+    }
 
     #[test]
     fn merged_items_are_the_stable_sort_by_target() {
