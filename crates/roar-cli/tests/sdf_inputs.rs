@@ -303,3 +303,62 @@ fn shared_neural_sdfs_reconstruct_closed_exact_and_near_their_zero_sets() {
         assert!(p99 < 1e-2 * diagonal, "{name}: 99th percentile {p99}");
     }
 }
+
+#[test]
+fn extract_writes_the_closed_zero_set_and_reports_its_evaluations() {
+    let dir = tempfile::tempdir().unwrap();
+    let shape = dir.path().join("ring.sdf.toml");
+    std::fs::write(
+        &shape,
+        "[shape]\ntype = \"torus\"\nmajor = 0.6\nminor = 0.25\n",
+    )
+    .unwrap();
+    let output = dir.path().join("ring.obj");
+    let out = roar(&[
+        "extract",
+        shape.to_str().unwrap(),
+        "-o",
+        output.to_str().unwrap(),
+        "--resolution",
+        "24",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let line: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(line["dims"], serde_json::json!([24, 24, 24]));
+    assert_eq!(
+        (line["values"].as_u64(), line["gradients"].as_u64()),
+        (Some(24 * 24 * 24), Some(0))
+    );
+    let soup = roar_io::read_mesh(&output).unwrap();
+    assert_eq!(soup.triangles.len() as u64, line["faces"].as_u64().unwrap());
+    let mesh = Mesh::from_triangles(soup.positions, &soup.triangles).expect("closed manifold");
+    assert_eq!(mesh.genus(), 1);
+    // A field with no zero set in the bounds, and an unreadable field: one line, no output.
+    std::fs::write(
+        &shape,
+        "[shape]\ntype = \"sphere\"\nradius = 0.5\ntranslate = [5, 0, 0]\n",
+    )
+    .unwrap();
+    let cone = dir.path().join("cone.sdf.toml");
+    std::fs::write(&cone, "[shape]\ntype = \"cone\"\n").unwrap();
+    for (input, expected) in [(&shape, "no zero set"), (&cone, "unknown type 'cone'")] {
+        let output = dir.path().join("none.obj");
+        let out = roar(&[
+            "extract",
+            input.to_str().unwrap(),
+            "-o",
+            output.to_str().unwrap(),
+            "--resolution",
+            "8",
+        ]);
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(!out.status.success());
+        assert!(stderr.contains(expected), "{stderr}");
+        assert_eq!(stderr.trim().lines().count(), 1, "{stderr}");
+        assert!(!output.exists());
+    }
+}

@@ -5,9 +5,11 @@
 //! [`GridSdf`]), all behind
 //! `roar_mesh::spatial::Sdf`, and what the pipeline needs from a field: its normal maps by
 //! grid-bracketed tracing ([`trace`]), the Face Split projector and the projection of samples
-//! onto the zero set ([`project`]), and the field in rig coordinates ([`RigSdf`]).
+//! onto the zero set ([`project`]), the field in rig coordinates ([`RigSdf`]), and the marching
+//! baseline that samples a field on a grid and extracts its zero set ([`extract`]).
 
 pub mod analytic;
+pub mod extract;
 pub mod grid;
 pub mod network;
 pub mod project;
@@ -20,6 +22,7 @@ use glam::DVec3;
 use roar_mesh::spatial::{Aabb, Normalization, Sdf, SdfEvaluations};
 
 pub use analytic::AnalyticSdf;
+pub use extract::{ExtractOptions, ExtractStats, extract_zero_set};
 pub use grid::GridSdf;
 pub use network::{Activation, Mlp};
 pub use project::{SdfProjector, SdfProjectorOptions, project_samples};

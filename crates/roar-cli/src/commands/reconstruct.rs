@@ -84,7 +84,7 @@ pub struct ReconstructArgs {
 }
 
 /// Parses `--bounds`: six finite numbers, each max above its min.
-fn parse_bounds(text: &str) -> Result<Aabb, String> {
+pub(crate) fn parse_bounds(text: &str) -> Result<Aabb, String> {
     let numbers: Vec<f64> = text
         .split(',')
         .map(|t| t.trim().parse::<f64>().map_err(|e| format!("{t:?}: {e}")))
