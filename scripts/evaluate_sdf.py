@@ -80,15 +80,26 @@ def main():
                 cmd += ["--config", a.config]
             if a.bounds:
                 cmd += ["--bounds", a.bounds]
-            proc, seconds, peak = timed(cmd)
+            timing = report + ".time"
+            if os.path.exists(mesh) and os.path.exists(report) and os.path.exists(timing):
+                # A finished run of an earlier invocation (the script resumes).
+                with open(timing) as f:
+                    seconds, peak = json.load(f)
+                ok, error = True, ""
+            else:
+                proc, seconds, peak = timed(cmd)
+                ok, error = proc.returncode == 0, proc.stderr.strip()
+                if ok:
+                    with open(timing, "w") as f:
+                        json.dump([seconds, peak], f)
             row = {"field": name, "method": "roar", "budget": n, "seconds": seconds, "peak_bytes": peak}
-            if proc.returncode != 0:
-                row["error"] = proc.stderr.strip().splitlines()[-1]
+            if not ok:
+                row["error"] = error.splitlines()[-1] if error else "failed"
             else:
                 with open(report) as f:
-                    evaluations = json.load(f)["sdf"]["evaluations"]
-                row["values"] = sum(evaluations["values"].values())
-                row["gradients"] = sum(evaluations["gradients"].values())
+                    sdf = json.load(f)["sdf"]
+                row["values"] = sum(sdf["values"].values())
+                row["gradients"] = sum(sdf["gradients"].values())
                 row.update(evaluate(a.roar, mesh, ref))
             print(row, file=sys.stderr)
             rows.append(row)
