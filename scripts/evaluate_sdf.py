@@ -132,9 +132,10 @@ def main():
             lines.append("| %s | %s | %d | %s | %s | | | | | | %s | |" % (
                 r["field"], r["method"], r["budget"], r.get("values", ""), r.get("gradients", ""), r["error"]))
             continue
-        lines.append("| %s | %s | %d | %d | %d | %.0f | %.2f | %s | %s | %s | %.3e | %.4f |" % (
+        peak = "n/a" if r["peak_bytes"] is None else "%.2f" % (r["peak_bytes"] / 1e9)
+        lines.append("| %s | %s | %d | %d | %d | %.0f | %s | %s | %s | %s | %.3e | %.4f |" % (
             r["field"], r["method"], r["budget"], r["values"], r["gradients"], r["seconds"],
-            (r["peak_bytes"] or 0) / 1e9, "yes" if r["closed"] else "no", r["genus"],
+            peak, "yes" if r["closed"] else "no", r["genus"],
             r["self_intersecting_faces"], r["chamfer_over_diag"], r["normal_cosine"]))
     table = "\n".join(lines) + "\n"
     with open(os.path.join(a.out, "table.md"), "w") as f:
