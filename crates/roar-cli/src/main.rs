@@ -34,6 +34,9 @@ enum Command {
     Init(commands::init::InitArgs),
     /// Guaranteed QEM of a closed 2-manifold to exactly N faces, without new self-intersections.
     Decimate(commands::decimate::DecimateArgs),
+    /// The marching baseline of a signed distance function: its zero set by marching tetrahedra
+    /// on a grid of R samples along the longest side, a closed 2-manifold (one JSON line of costs).
+    Extract(commands::extract::ExtractArgs),
     /// Write the patches of a range-scan set (a `.conf` or its folder), aligned as
     /// `reconstruct` aligns them, as one mesh to look at.
     Scans(commands::scans::ScansArgs),
@@ -74,6 +77,7 @@ fn main() -> ExitCode {
         Command::Render(args) => commands::render::run(&args),
         Command::Init(args) => commands::init::run(&args),
         Command::Decimate(args) => commands::decimate::run(&args),
+        Command::Extract(args) => commands::extract::run(&args),
         Command::Scans(args) => commands::scans::run(&args),
         Command::ExampleSoup(args) => commands::example::run(&args),
         Command::Batch(args) => commands::batch::run(&args),

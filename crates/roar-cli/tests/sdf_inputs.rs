@@ -1,6 +1,6 @@
 //! SDF inputs through the CLI and the pipeline: the SDF schedule's defaults, one-line errors
 //! for bad files with no output, and (release, run by `.ci/run` with `--ignored`) reduced
-//! reconstructions of analytic shapes and of the two shared neural SDFs, each a closed,
+//! reconstructions of analytic shapes, of a dense grid and of the two shared neural SDFs, each a closed,
 //! oriented 2-manifold with exactly the budget, no self-intersecting faces and its vertices near
 //! the zero set.
 
@@ -15,7 +15,7 @@ use roar_cli::pipeline::sdf::DEFAULT_BOUNDS;
 use roar_cli::pipeline::{ReconstructConfig, Reconstruction, SdfShape};
 use roar_mesh::Mesh;
 use roar_mesh::spatial::{Aabb, Sdf, evaluate_with_gradients, self_intersecting_faces};
-use roar_sdf::{AnalyticSdf, load_sdf};
+use roar_sdf::{AnalyticSdf, load_sdf, load_sdf_input};
 
 fn roar(args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_roar"))
@@ -63,7 +63,13 @@ fn print_config_of_an_sdf_input_gives_the_sdf_schedule() {
 #[test]
 fn bad_sdf_files_fail_in_one_line_and_write_nothing() {
     let dir = tempfile::tempdir().unwrap();
-    let cases: [(&str, &[u8], &str); 3] = [
+    let flat = npy_f32(&[4, 4], &[0.0; 16], false);
+    let mut holed = vec![1.0f32; 27];
+    holed[5] = f32::NAN;
+    let holed = npy_f32(&[3, 3, 3], &holed, false);
+    let cases: [(&str, &[u8], &str); 5] = [
+        ("flat.npy", &flat, "has 2 axes [4, 4]"),
+        ("holed.npy", &holed, "NaN at [0, 1, 2]"),
         (
             "cone.sdf.toml",
             b"[shape]\ntype = \"cone\"\n",
@@ -100,6 +106,28 @@ fn bad_sdf_files_fail_in_one_line_and_write_nothing() {
         "0,0,0,1,1",
     ]);
     assert!(String::from_utf8_lossy(&out.stderr).contains("six numbers"));
+}
+
+/// The bytes of an `.npy` file (format 1.0, little-endian float32) of `shape`, holding `values`
+/// in C order, or in Fortran order when `fortran` (written here, not by the reader's crate).
+fn npy_f32(shape: &[usize], values: &[f32], fortran: bool) -> Vec<u8> {
+    let dims: Vec<String> = shape.iter().map(|n| n.to_string()).collect();
+    let mut header = format!(
+        "{{'descr': '<f4', 'fortran_order': {}, 'shape': ({},), }}",
+        if fortran { "True" } else { "False" },
+        dims.join(", ")
+    );
+    while (10 + header.len() + 1) % 64 != 0 {
+        header.push(' ');
+    }
+    header.push('\n');
+    let mut bytes = b"\x93NUMPY\x01\x00".to_vec();
+    bytes.extend((header.len() as u16).to_le_bytes());
+    bytes.extend(header.as_bytes());
+    for v in values {
+        bytes.extend(v.to_le_bytes());
+    }
+    bytes
 }
 
 /// Toy settings for an SDF input at `faces`, with the SDF loss on for the second half; the Face
@@ -195,6 +223,54 @@ half_height = 1.0
     );
 }
 
+#[test]
+#[ignore = "release: a reduced reconstruction of a dense grid (run by .ci/run)"]
+fn a_dense_grid_of_a_sphere_reconstructs_within_one_percent() {
+    // |p − c| − r sampled on a 40 × 36 × 38 grid (Fortran order) over the sidecar's bounds.
+    let (centre, radius) = (DVec3::new(0.2, -0.1, 0.15), 0.65);
+    let bounds = Aabb {
+        min: DVec3::new(-0.7, -1.0, -0.8),
+        max: DVec3::new(1.1, 0.9, 1.0),
+    };
+    let n = [40, 36, 38];
+    let mut values = Vec::with_capacity(n[0] * n[1] * n[2]);
+    for k in 0..n[2] {
+        for j in 0..n[1] {
+            for i in 0..n[0] {
+                let t = DVec3::new(i as f64, j as f64, k as f64)
+                    / DVec3::new((n[0] - 1) as f64, (n[1] - 1) as f64, (n[2] - 1) as f64);
+                let p = bounds.min + t * (bounds.max - bounds.min);
+                values.push(((p - centre).length() - radius) as f32);
+            }
+        }
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("ball.npy");
+    std::fs::write(&path, npy_f32(&n, &values, true)).unwrap();
+    std::fs::write(
+        dir.path().join("ball.json"),
+        r#"{"min": [-0.7, -1.0, -0.8], "max": [1.1, 0.9, 1.0]}"#,
+    )
+    .unwrap();
+    let input = load_sdf_input(&path, DEFAULT_BOUNDS).unwrap();
+    assert_eq!(input.bounds, Some(bounds));
+    let (mesh, _) = reconstruct(input.field, bounds, 1000, true);
+    assert_eq!(mesh.genus(), 0);
+    let diagonal = 2.0 * radius * 3f64.sqrt();
+    let farthest = mesh
+        .vertices()
+        .map(|v| ((mesh.position(v) - centre).length() - radius).abs())
+        .fold(0.0, f64::max);
+    println!(
+        "grid sphere: farthest vertex {:.2e} of the diagonal",
+        farthest / diagonal
+    );
+    assert!(
+        farthest < 0.01 * diagonal,
+        "farthest vertex {farthest} off the sphere"
+    );
+}
+
 /// The shared neural SDFs, or `None` (with a note) outside CI when `ROAR_SDF_DATA` is unset.
 fn sdf_data() -> Option<PathBuf> {
     let Some(root) = std::env::var_os("ROAR_SDF_DATA") else {
@@ -229,5 +305,64 @@ fn shared_neural_sdfs_reconstruct_closed_exact_and_near_their_zero_sets() {
         );
         assert!(mean < 2e-3 * diagonal, "{name}: mean {mean}");
         assert!(p99 < 1e-2 * diagonal, "{name}: 99th percentile {p99}");
+    }
+}
+
+#[test]
+fn extract_writes_the_closed_zero_set_and_reports_its_evaluations() {
+    let dir = tempfile::tempdir().unwrap();
+    let shape = dir.path().join("ring.sdf.toml");
+    std::fs::write(
+        &shape,
+        "[shape]\ntype = \"torus\"\nmajor = 0.6\nminor = 0.25\n",
+    )
+    .unwrap();
+    let output = dir.path().join("ring.obj");
+    let out = roar(&[
+        "extract",
+        shape.to_str().unwrap(),
+        "-o",
+        output.to_str().unwrap(),
+        "--resolution",
+        "24",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let line: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(line["dims"], serde_json::json!([24, 24, 24]));
+    assert_eq!(
+        (line["values"].as_u64(), line["gradients"].as_u64()),
+        (Some(24 * 24 * 24), Some(0))
+    );
+    let soup = roar_io::read_mesh(&output).unwrap();
+    assert_eq!(soup.triangles.len() as u64, line["faces"].as_u64().unwrap());
+    let mesh = Mesh::from_triangles(soup.positions, &soup.triangles).expect("closed manifold");
+    assert_eq!(mesh.genus(), 1);
+    // A field with no zero set in the bounds, and an unreadable field: one line, no output.
+    std::fs::write(
+        &shape,
+        "[shape]\ntype = \"sphere\"\nradius = 0.5\ntranslate = [5, 0, 0]\n",
+    )
+    .unwrap();
+    let cone = dir.path().join("cone.sdf.toml");
+    std::fs::write(&cone, "[shape]\ntype = \"cone\"\n").unwrap();
+    for (input, expected) in [(&shape, "no zero set"), (&cone, "unknown type 'cone'")] {
+        let output = dir.path().join("none.obj");
+        let out = roar(&[
+            "extract",
+            input.to_str().unwrap(),
+            "-o",
+            output.to_str().unwrap(),
+            "--resolution",
+            "8",
+        ]);
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(!out.status.success());
+        assert!(stderr.contains(expected), "{stderr}");
+        assert_eq!(stderr.trim().lines().count(), 1, "{stderr}");
+        assert!(!output.exists());
     }
 }

@@ -1,12 +1,16 @@
 //! # roar-sdf
 //!
 //! Signed distance functions as inputs of roar (spec §5): readers for the kinds of field
-//! (an analytic `.sdf.toml` [`AnalyticSdf`], a neural MLP `.npz` [`Mlp`]), all behind
+//! (an analytic `.sdf.toml` [`AnalyticSdf`], a neural MLP `.npz` [`Mlp`], a dense `.npy` grid
+//! [`GridSdf`]), all behind
 //! `roar_mesh::spatial::Sdf`, and what the pipeline needs from a field: its normal maps by
 //! grid-bracketed tracing ([`trace`]), the Face Split projector and the projection of samples
-//! onto the zero set ([`project`]), and the field in rig coordinates ([`RigSdf`]).
+//! onto the zero set ([`project`]), the field in rig coordinates ([`RigSdf`]), and the marching
+//! baseline that samples a field on a grid and extracts its zero set ([`extract`]).
 
 pub mod analytic;
+pub mod extract;
+pub mod grid;
 pub mod network;
 pub mod project;
 pub mod trace;
@@ -15,9 +19,11 @@ use std::path::Path;
 use std::sync::Arc;
 
 use glam::DVec3;
-use roar_mesh::spatial::{Normalization, Sdf, SdfEvaluations};
+use roar_mesh::spatial::{Aabb, Normalization, Sdf, SdfEvaluations};
 
 pub use analytic::AnalyticSdf;
+pub use extract::{ExtractOptions, ExtractStats, extract_zero_set};
+pub use grid::GridSdf;
 pub use network::{Activation, Mlp};
 pub use project::{SdfProjector, SdfProjectorOptions, project_samples};
 pub use trace::{TraceOptions, TraceStats, trace_normal_maps};
@@ -34,30 +40,68 @@ pub enum SdfError {
     /// A malformed `.sdf.toml` file (names the node).
     #[error("{0}")]
     Analytic(String),
+    /// A malformed `.npy` grid or its sidecar.
+    #[error("{0}")]
+    Grid(String),
     /// The file's extension names no SDF kind.
-    #[error("not an SDF input (.npz or .sdf.toml)")]
+    #[error("not an SDF input (.npz, .sdf.toml or .npy)")]
     UnknownKind,
 }
 
-/// True when `path` names an SDF input by its extension: `.npz` or `.sdf.toml`.
+/// The bounds an SDF input is reconstructed in, and a grid without a sidecar is placed over,
+/// when none are given: `[-1.1, 1.1]³`.
+pub const DEFAULT_BOUNDS: Aabb = Aabb {
+    min: DVec3::splat(-1.1),
+    max: DVec3::splat(1.1),
+};
+
+/// An SDF input as read: its field and, when the file places it (a grid's sidecar), its bounds.
+pub struct SdfInput {
+    /// The field in the input's coordinates.
+    pub field: Arc<dyn Sdf>,
+    /// The bounds the file gives, if any.
+    pub bounds: Option<Aabb>,
+}
+
+/// True when `path` names an SDF input by its extension: `.npz`, `.sdf.toml` or `.npy`.
 pub fn is_sdf_path(path: &Path) -> bool {
     let name = path
         .file_name()
         .map(|n| n.to_string_lossy().to_ascii_lowercase())
         .unwrap_or_default();
-    name.ends_with(".npz") || name.ends_with(".sdf.toml")
+    name.ends_with(".npz") || name.ends_with(".sdf.toml") || name.ends_with(".npy")
 }
 
-/// Reads the SDF at `path`, of the kind its extension names ([`is_sdf_path`]).
+/// Reads the SDF at `path`, of the kind its extension names ([`is_sdf_path`]); a grid without
+/// a sidecar is placed over [`DEFAULT_BOUNDS`].
 pub fn load_sdf(path: &Path) -> Result<Arc<dyn Sdf>, SdfError> {
+    Ok(load_sdf_input(path, DEFAULT_BOUNDS)?.field)
+}
+
+/// Reads the SDF at `path` ([`load_sdf`]) with the bounds its file gives; a grid without a
+/// sidecar is placed over `grid_bounds`.
+pub fn load_sdf_input(path: &Path, grid_bounds: Aabb) -> Result<SdfInput, SdfError> {
     let name = path
         .file_name()
         .map(|n| n.to_string_lossy().to_ascii_lowercase())
         .unwrap_or_default();
     if name.ends_with(".npz") {
-        Ok(Arc::new(Mlp::from_npz_file(path)?))
+        Ok(SdfInput {
+            field: Arc::new(Mlp::from_npz_file(path)?),
+            bounds: None,
+        })
     } else if name.ends_with(".sdf.toml") {
-        Ok(Arc::new(AnalyticSdf::from_file(path)?))
+        Ok(SdfInput {
+            field: Arc::new(AnalyticSdf::from_file(path)?),
+            bounds: None,
+        })
+    } else if name.ends_with(".npy") {
+        let bounds = grid::read_sidecar(path)?;
+        let grid = GridSdf::from_npy_file(path, bounds.unwrap_or(grid_bounds))?;
+        Ok(SdfInput {
+            field: Arc::new(grid),
+            bounds,
+        })
     } else {
         Err(SdfError::UnknownKind)
     }

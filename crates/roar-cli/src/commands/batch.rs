@@ -210,13 +210,15 @@ pub fn run(args: &BatchArgs) -> anyhow::Result<()> {
 }
 
 /// The `reconstruct` arguments of an item (or of the batch alone), for the configuration hash.
+/// The item's input is among them: it picks the defaults (an SDF input's schedule, a scan
+/// set's) that the child starts from.
 fn reconstruct_args(
     args: &BatchArgs,
     item: Option<&Item>,
     budget: Option<usize>,
 ) -> ReconstructArgs {
     ReconstructArgs {
-        input: None,
+        input: item.map(|i| i.input.clone()),
         output: None,
         faces: budget,
         config: args.config.clone(),
@@ -497,7 +499,45 @@ impl Progress {
 
 #[cfg(test)]
 mod tests {
-    use super::parse_memory;
+    use super::{BatchArgs, effective_config, parse_memory, reconstruct_args};
+    use crate::batch::manifest::Item;
+    use crate::pipeline::ReconstructConfig;
+    use clap::Parser;
+
+    #[derive(Parser)]
+    struct Cli {
+        #[command(flatten)]
+        args: BatchArgs,
+    }
+
+    #[test]
+    fn an_item_is_hashed_with_the_defaults_of_its_input_kind() {
+        let cli = Cli::parse_from(["batch", "manifest.csv", "-o", "out", "--faces", "200"]);
+        let config_of = |input: &str| {
+            let item = Item {
+                id: "x".into(),
+                input: input.into(),
+                faces: None,
+                iterations: None,
+                seed: None,
+                timeout: None,
+                line: 2,
+            };
+            effective_config(&reconstruct_args(&cli.args, Some(&item), Some(200))).unwrap()
+        };
+        // What the child `roar reconstruct ITEM --faces 200` starts from.
+        let faces = |c: ReconstructConfig| ReconstructConfig { faces: 200, ..c };
+        assert_eq!(
+            config_of("net.npz"),
+            faces(ReconstructConfig::sdf_defaults())
+        );
+        assert_eq!(
+            config_of("grid.npy"),
+            faces(ReconstructConfig::sdf_defaults())
+        );
+        assert_eq!(config_of("chair.obj"), faces(ReconstructConfig::default()));
+        assert_ne!(config_of("net.npz"), config_of("chair.obj"));
+    }
 
     #[test]
     fn memory_sizes_parse() {

@@ -6,6 +6,7 @@ pub mod batch_report;
 pub mod decimate;
 pub mod eval;
 pub mod example;
+pub mod extract;
 pub mod info;
 pub mod init;
 pub mod reconstruct;

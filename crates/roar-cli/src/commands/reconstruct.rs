@@ -27,8 +27,8 @@ use crate::pipeline::{
 pub struct ReconstructArgs {
     /// Any triangle soup (OBJ, PLY, STL or OFF; a PLY range image is its patch), a set of range
     /// scans (a Stanford `.conf` or the folder holding one; `docs/scans.md`), or a signed
-    /// distance function: a neural MLP (`.npz`) or an analytic shape (`.sdf.toml`), negative
-    /// inside (`docs/sdf.md`).
+    /// distance function: a neural MLP (`.npz`), an analytic shape (`.sdf.toml`) or a dense grid
+    /// (`.npy`, bounds from its `.json` sidecar), negative inside (`docs/sdf.md`).
     pub input: Option<PathBuf>,
     /// Where to write the result (format by extension).
     #[arg(short, long)]
@@ -76,14 +76,15 @@ pub struct ReconstructArgs {
     /// Run even when the estimated memory of the budget exceeds what this machine has.
     #[arg(long)]
     pub force: bool,
-    /// Box to reconstruct an SDF input in, `xmin,ymin,zmin,xmax,ymax,zmax` (default
-    /// `-1.1,-1.1,-1.1,1.1,1.1,1.1`); it must hold the zero set.
+    /// Box to reconstruct an SDF input in, `xmin,ymin,zmin,xmax,ymax,zmax` (default: a grid's
+    /// sidecar bounds, else `-1.1,-1.1,-1.1,1.1,1.1,1.1`); it must hold the zero set. A grid
+    /// without a sidecar is placed over it.
     #[arg(long, value_parser = parse_bounds, allow_hyphen_values = true)]
     pub bounds: Option<Aabb>,
 }
 
 /// Parses `--bounds`: six finite numbers, each max above its min.
-fn parse_bounds(text: &str) -> Result<Aabb, String> {
+pub(crate) fn parse_bounds(text: &str) -> Result<Aabb, String> {
     let numbers: Vec<f64> = text
         .split(',')
         .map(|t| t.trim().parse::<f64>().map_err(|e| format!("{t:?}: {e}")))
@@ -295,8 +296,8 @@ fn file_name(path: &std::path::Path) -> String {
     )
 }
 
-/// Reconstructs an SDF input (`.npz`, `.sdf.toml`): reads the field (one-line errors, nothing
-/// written on failure), runs the pipeline on its [`SdfShape`] inside `--bounds`, and reports the
+/// Reconstructs an SDF input (`.npz`, `.sdf.toml`, `.npy`): reads the field (one-line errors, nothing
+/// written on failure), runs the pipeline on its [`SdfShape`] inside `--bounds` (or a grid's sidecar bounds), and reports the
 /// field's evaluations and how far the output's vertices are from the zero set.
 fn run_sdf(
     args: &ReconstructArgs,
@@ -310,10 +311,11 @@ fn run_sdf(
             input.display()
         );
     }
-    let field =
-        roar_sdf::load_sdf(input).map_err(|e| anyhow::anyhow!("{}: {e}", input.display()))?;
+    let loaded = roar_sdf::load_sdf_input(input, args.bounds.unwrap_or(DEFAULT_BOUNDS))
+        .map_err(|e| anyhow::anyhow!("{}: {e}", input.display()))?;
+    let field = loaded.field;
     check_resources(&config, 0, args.force)?;
-    let bounds = args.bounds.unwrap_or(DEFAULT_BOUNDS);
+    let bounds = args.bounds.or(loaded.bounds).unwrap_or(DEFAULT_BOUNDS);
     let mut progress = Progress::new(args.quiet, config.optimize.iterations);
     let mut shape = SdfShape::new(file_name(input), field.clone(), bounds, &config);
     let mut reconstruction = Reconstruction::new(config.clone());

@@ -1,5 +1,5 @@
 //! A signed distance function as a [`Shape`] (spec §5): the input kind `roar reconstruct` reads
-//! from `.npz` networks and `.sdf.toml` files (`roar_sdf`).
+//! from `.npz` networks, `.sdf.toml` files and `.npy` grids (`roar_sdf`).
 //!
 //! In rig coordinates (the bounds' centre at the origin, their corners on the rig's sphere):
 //! the target renders are traced normal maps of the zero set (`roar_sdf::trace`); the initial
@@ -12,7 +12,6 @@ use std::borrow::Cow;
 use std::collections::BTreeMap;
 use std::sync::{Arc, Mutex};
 
-use glam::DVec3;
 use roar_loss::{InitialMesh, LossError, PointCloud, Shape, ShapeError};
 use roar_mesh::Mesh;
 use roar_mesh::spatial::{
@@ -26,10 +25,7 @@ use serde::Serialize;
 use super::ReconstructConfig;
 
 /// The bounds an SDF input is reconstructed in when none are given: `[-1.1, 1.1]³`.
-pub const DEFAULT_BOUNDS: Aabb = Aabb {
-    min: DVec3::splat(-1.1),
-    max: DVec3::splat(1.1),
-};
+pub const DEFAULT_BOUNDS: Aabb = roar_sdf::DEFAULT_BOUNDS;
 
 /// Evaluations of an SDF input's field by what asked for them, for reports.
 #[derive(Clone, Debug, Default, Serialize)]

@@ -15,10 +15,11 @@
 //! [`winding`] (fast winding numbers), [`regular_sampling`] (regular per-face grids),
 //! [`projector`] (the `Projector` trait), [`ray_projector`] (exact ray-cast projection, §3.4 (B)),
 //! [`vertex_normals`](mod@vertex_normals) (the ROAR vertex normals, §2.2), [`sdf`] (the `Sdf` trait
-//! of signed distance inputs).
+//! of signed distance inputs), [`isosurface`] (marching tetrahedra over a grid of values).
 
 pub mod aabb;
 pub mod bvh;
+pub mod isosurface;
 pub mod normalization;
 pub mod point_triangle;
 pub mod projector;
@@ -33,6 +34,7 @@ pub mod winding;
 
 pub use aabb::Aabb;
 pub use bvh::{CertifiedClosest, ClosestPoint, RayHit, TriangleBvh};
+pub use isosurface::marching_tetrahedra;
 pub use normalization::{Normalization, RIG_RADIUS};
 pub use point_triangle::{closest_point_on_triangle, ray_triangle};
 pub use projector::{Projector, SphereProjector};

@@ -1,0 +1,147 @@
+#!/usr/bin/env python3
+"""The work of scripts/evaluate_sdf.sh (read its header): roar against the marching baseline on
+SDF inputs, every output measured against the reference surface; writes OUT/table.md and
+OUT/results.json."""
+
+import argparse
+import json
+import os
+import subprocess
+import sys
+import time
+
+
+def timed(cmd):
+    """Runs `cmd` under /usr/bin/time -v; returns (completed process, seconds, peak bytes)."""
+    started = time.perf_counter()
+    proc = subprocess.run(["/usr/bin/time", "-v"] + cmd, capture_output=True, text=True)
+    seconds = time.perf_counter() - started
+    peak = None
+    for line in proc.stderr.splitlines():
+        if "Maximum resident set size" in line:
+            peak = int(line.split(":")[1]) * 1024
+    return proc, seconds, peak
+
+
+def evaluate(roar, mesh, ref):
+    """The figures of the table from `roar eval MESH --ref REF --json`."""
+    proc = subprocess.run([roar, "eval", mesh, "--ref", ref, "--json"], capture_output=True, text=True)
+    if proc.returncode != 0:
+        return {"error": proc.stderr.strip()}
+    r = json.loads(proc.stdout)
+    topo = r["topology_welded"]
+    return {
+        "faces": topo["faces"],
+        "closed": bool(topo["watertight"]),
+        "genus": topo.get("genus"),
+        "self_intersecting_faces": (r.get("self_intersections") or {}).get("faces"),
+        "chamfer_over_diag": r["fidelity"]["chamfer_l2_over_diag"],
+        "normal_cosine": r["fidelity"]["normal_cosine"],
+    }
+
+
+def extract(roar, field, mesh, resolution, bounds):
+    """`roar extract`; returns its JSON line plus seconds and peak bytes."""
+    cmd = [roar, "extract", field, "-o", mesh, "--resolution", str(resolution)]
+    if bounds:
+        cmd += ["--bounds", bounds]
+    proc, seconds, peak = timed(cmd)
+    if proc.returncode != 0:
+        sys.exit("extract failed: " + proc.stderr.strip().splitlines()[-1])
+    line = json.loads(proc.stdout.strip().splitlines()[-1])
+    line.update(seconds=seconds, peak_bytes=peak)
+    return line
+
+
+def main():
+    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    p.add_argument("--roar", required=True)
+    p.add_argument("--fields", nargs="+", required=True)
+    p.add_argument("--budgets", nargs="+", type=int, required=True)
+    p.add_argument("--resolutions", nargs="+", type=int, required=True)
+    p.add_argument("--reference", type=int, required=True)
+    p.add_argument("--config", default="")
+    p.add_argument("--bounds", default="")
+    p.add_argument("--out", required=True)
+    a = p.parse_args()
+    rows = []
+    for field in a.fields:
+        name = os.path.basename(field).split(".")[0]
+        ref = os.path.join(a.out, "%s-reference-%d.obj" % (name, a.reference))
+        if not os.path.exists(ref):
+            info = extract(a.roar, field, ref, a.reference, a.bounds)
+            print("%s: reference %d³ %.0f s, %d faces" % (name, a.reference, info["seconds"], info["faces"]),
+                  file=sys.stderr)
+        for n in a.budgets:
+            mesh = os.path.join(a.out, "%s-roar-%d.obj" % (name, n))
+            report = os.path.join(a.out, "%s-roar-%d.json" % (name, n))
+            cmd = [a.roar, "reconstruct", field, "-o", mesh, "--faces", str(n), "-q", "--report", report]
+            if a.config:
+                cmd += ["--config", a.config]
+            if a.bounds:
+                cmd += ["--bounds", a.bounds]
+            timing = report + ".time"
+            if os.path.exists(mesh) and os.path.exists(report) and os.path.exists(timing):
+                # A finished run of an earlier invocation (the script resumes).
+                with open(timing) as f:
+                    seconds, peak = json.load(f)
+                ok, error = True, ""
+            else:
+                proc, seconds, peak = timed(cmd)
+                ok, error = proc.returncode == 0, proc.stderr.strip()
+                if ok:
+                    with open(timing, "w") as f:
+                        json.dump([seconds, peak], f)
+            row = {"field": name, "method": "roar", "budget": n, "seconds": seconds, "peak_bytes": peak}
+            if not ok:
+                row["error"] = error.splitlines()[-1] if error else "failed"
+            else:
+                with open(report) as f:
+                    sdf = json.load(f)["sdf"]
+                row["values"] = sum(sdf["values"].values())
+                row["gradients"] = sum(sdf["gradients"].values())
+                row.update(evaluate(a.roar, mesh, ref))
+            print(row, file=sys.stderr)
+            rows.append(row)
+        for r in a.resolutions:
+            grid = os.path.join(a.out, "%s-mt-%d.obj" % (name, r))
+            info = extract(a.roar, field, grid, r, a.bounds)
+            for n in a.budgets:
+                row = {"field": name, "method": "marching tetrahedra %d³ + QEM" % r, "budget": n,
+                       "values": info["values"], "gradients": info["gradients"]}
+                mesh = os.path.join(a.out, "%s-mt-%d-%d.obj" % (name, r, n))
+                if info["faces"] < n:
+                    row["error"] = "the grid gives %d faces, under the budget" % info["faces"]
+                else:
+                    proc, seconds, peak = timed([a.roar, "decimate", grid, "-o", mesh, "--faces", str(n)])
+                    row["seconds"] = info["seconds"] + seconds
+                    row["peak_bytes"] = max(info["peak_bytes"] or 0, peak or 0)
+                    if proc.returncode != 0:
+                        row["error"] = proc.stderr.strip().splitlines()[-1]
+                    else:
+                        row.update(evaluate(a.roar, mesh, ref))
+                print(row, file=sys.stderr)
+                rows.append(row)
+    with open(os.path.join(a.out, "results.json"), "w") as f:
+        json.dump(rows, f, indent=1)
+    lines = ["| field | method | N | SDF values | SDF gradients | seconds | peak GB | closed | genus "
+             "| self-int. faces | Chamfer/diag | normal cosine |",
+             "|---|---|---|---|---|---|---|---|---|---|---|---|"]
+    for r in rows:
+        if "error" in r:
+            lines.append("| %s | %s | %d | %s | %s | | | | | | %s | |" % (
+                r["field"], r["method"], r["budget"], r.get("values", ""), r.get("gradients", ""), r["error"]))
+            continue
+        peak = "n/a" if r["peak_bytes"] is None else "%.2f" % (r["peak_bytes"] / 1e9)
+        lines.append("| %s | %s | %d | %d | %d | %.0f | %s | %s | %s | %s | %.3e | %.4f |" % (
+            r["field"], r["method"], r["budget"], r["values"], r["gradients"], r["seconds"],
+            peak, "yes" if r["closed"] else "no", r["genus"],
+            r["self_intersecting_faces"], r["chamfer_over_diag"], r["normal_cosine"]))
+    table = "\n".join(lines) + "\n"
+    with open(os.path.join(a.out, "table.md"), "w") as f:
+        f.write(table)
+    print(table)
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,50 @@
+#!/usr/bin/env bash
+# roar against the marching baseline on SDF inputs (docs/sdf.md): for each field, roar at every
+# budget and, at every grid resolution, `roar extract` (marching tetrahedra) decimated to the
+# budget by `roar decimate` (roar's QEM). Every output is measured by `roar eval --ref` against
+# the reference surface, the marching extraction of the same field at the reference resolution;
+# the table gives the field's evaluations (values and gradients), seconds, peak memory, Chamfer/
+# diag and normal cosine. Writes DIR/table.md and DIR/results.json.
+#
+#   scripts/evaluate_sdf.sh [--fields "A.npz B.npz"] [--budgets "5000 50000"]
+#       [--resolutions "32 64 128 256 512"] [--reference 512] [--config FILE] [--out DIR]
+#
+# Defaults: the two shared networks (../shared/data/sdf/nif-bunny.npz, nif-hammer.npz), budgets
+# 5000 and 50000, resolutions 32 to 512, reference 512, DIR target/evaluate-sdf; roar with the SDF
+# schedule's defaults unless --config gives a file of overrides. Needs python3 (no packages).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+repo="$(pwd)"
+
+data="${ROAR_SDF_DATA:-$repo/../shared/data/sdf}"
+fields="$data/nif-bunny.npz $data/nif-hammer.npz"
+budgets="5000 50000"
+resolutions="32 64 128 256 512"
+reference=512
+config=""
+out="target/evaluate-sdf"
+while [ $# -gt 0 ]; do
+  case "$1" in
+    --fields) fields="$2"; shift 2 ;;
+    --budgets) budgets="$2"; shift 2 ;;
+    --resolutions) resolutions="$2"; shift 2 ;;
+    --reference) reference="$2"; shift 2 ;;
+    --config) config="$2"; shift 2 ;;
+    --out) out="$2"; shift 2 ;;
+    -h|--help) sed -n '2,15p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    *) echo "evaluate_sdf.sh: unknown argument $1" >&2; exit 2 ;;
+  esac
+done
+for f in $fields; do
+  if [ ! -f "$f" ]; then
+    echo "evaluate_sdf.sh: no SDF at '$f' (--fields, or set ROAR_SDF_DATA)" >&2
+    exit 2
+  fi
+done
+
+echo "== building roar (release)" >&2
+cargo build --release -q -p roar-cli
+mkdir -p "$out"
+exec python3 "$repo/scripts/evaluate_sdf.py" --roar "$repo/target/release/roar" --fields $fields \
+  --budgets $budgets --resolutions $resolutions --reference "$reference" --config "$config" \
+  --out "$out"
