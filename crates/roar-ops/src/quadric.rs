@@ -90,7 +90,8 @@ fn solve_positive_definite(a: [f64; 6], r: DVec3, min_det: f64) -> Option<DVec3>
     let l = cholesky.l_dirty();
     let root_det = l[(0, 0)] * l[(1, 1)] * l[(2, 2)];
     // NaN fails the comparison and is rejected too.
-    if !(root_det * root_det > min_det) {
+    let well_conditioned = root_det * root_det > min_det;
+    if !well_conditioned {
         return None;
     }
     let x = cholesky.solve(&Vector3::new(r.x, r.y, r.z));

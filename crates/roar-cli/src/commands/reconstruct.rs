@@ -13,7 +13,9 @@ use roar_eval::{EvalOptions, Report};
 use serde::Serialize;
 
 use crate::checks::check_paths;
+use crate::preview::{PreviewInput, PreviewOptions, preview_cameras};
 use glam::DVec3;
+use roar_loss::Shape;
 use roar_mesh::spatial::{Aabb, evaluate_with_gradients};
 
 use crate::pipeline::sdf::{DEFAULT_BOUNDS, SdfReport};
@@ -64,7 +66,8 @@ pub struct ReconstructArgs {
     #[arg(long)]
     pub report: Option<PathBuf>,
     /// Also write a PNG picture: input and output from the same four views (the output with its
-    /// wireframe) and the loss curve of the run.
+    /// wireframe) and the loss curve of the run. The input is the soup, a scan set's aligned
+    /// patches, or an SDF's zero set traced from those views.
     #[arg(long)]
     pub preview: Option<PathBuf>,
     /// Print the effective configuration as TOML and exit.
@@ -238,7 +241,7 @@ pub fn run(args: &ReconstructArgs) -> anyhow::Result<()> {
         args,
         &report,
         &out_soup,
-        Some((&soup.positions, &soup.triangles)),
+        PreviewInput::Soup(&soup.positions, &soup.triangles),
     )
 }
 
@@ -247,7 +250,7 @@ fn write_outputs(
     args: &ReconstructArgs,
     report: &ReconstructReport,
     out_soup: &roar_io::TriangleSoup,
-    input_soup: Option<(&[DVec3], &[[u32; 3]])>,
+    preview_input: PreviewInput<'_>,
 ) -> anyhow::Result<()> {
     let output = args.output.as_ref().context("-o OUTPUT is required")?;
     for failure in &report.run.untangle_failures {
@@ -265,11 +268,11 @@ fn write_outputs(
         .map(|path| (path.as_path(), json.as_bytes()))
         .collect();
     roar_io::write_mesh_and_files(output, out_soup, &roar_io::WriteOptions::default(), &others)?;
-    if let (Some(preview), Some(input)) = (&args.preview, input_soup) {
+    if let Some(preview) = &args.preview {
         let losses: Vec<f64> = report.run.history.iter().map(|r| r.loss).collect();
         crate::preview::write_preview(
             preview,
-            input,
+            preview_input,
             (&out_soup.positions, &out_soup.triangles),
             &losses,
             &crate::preview::PreviewOptions::default(),
@@ -304,12 +307,6 @@ fn run_sdf(
     input: &std::path::Path,
     started: Instant,
 ) -> anyhow::Result<()> {
-    if args.preview.is_some() {
-        anyhow::bail!(
-            "--preview pictures a soup input; {} is an SDF",
-            input.display()
-        );
-    }
     let field =
         roar_sdf::load_sdf(input).map_err(|e| anyhow::anyhow!("{}: {e}", input.display()))?;
     check_resources(&config, 0, args.force)?;
@@ -322,6 +319,12 @@ fn run_sdf(
         .with_context(|| format!("{}: reconstruction failed", input.display()));
     progress.finish();
     let result = result?;
+    // Traced before the report, so the report counts the preview's evaluations.
+    let preview_views = args
+        .preview
+        .as_ref()
+        .map(|_| shape.preview_views(&preview_cameras(PreviewOptions::default().tile)))
+        .unwrap_or_default();
     let evaluations = shape.report();
     let (values, gradients) = evaluate_with_gradients(field.as_ref(), &result.positions);
     let distances: Vec<f64> = values
@@ -356,7 +359,11 @@ fn run_sdf(
             output_distance_max: distances.iter().copied().fold(0.0, f64::max),
         }),
     };
-    write_outputs(args, &report, &out_soup, None)
+    let preview_input = PreviewInput::Views {
+        normalization: shape.normalization(),
+        views: &preview_views,
+    };
+    write_outputs(args, &report, &out_soup, preview_input)
 }
 
 /// `defaults` overridden by the keys of the TOML file at `path`, if any; a parse error or an
