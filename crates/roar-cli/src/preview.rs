@@ -2,9 +2,11 @@
 //! input (top row) and the output (bottom row) shaded from the same four views, the output with
 //! its wireframe, and under them the loss curve of the run.
 //!
-//! Both meshes are framed by the input's normalization (so they line up tile for tile) and
-//! rendered by roar's own rasterizer (`roar_render::render`, both sides, no antialiasing);
-//! shading is a headlight: brightness `0.25 + 0.75·|n·d|` for face normal `n` and viewing
+//! The input is a soup (a scan set's aligned patches are one) or views of it already rendered
+//! by [`preview_cameras`] (an SDF's traced zero set, [`PreviewInput::Views`]). Both rows are
+//! framed by one normalization (the soup's own, or the SDF's rig), so they line up tile for
+//! tile; meshes are rendered by roar's own rasterizer (`roar_render::render`, both sides, no
+//! antialiasing); shading is a headlight: brightness `0.25 + 0.75·|n·d|` for face normal `n` and viewing
 //! direction `d`, so the inward faces of a soup show as well as outward ones. Wire edges are
 //! drawn where they are not hidden by the surface (a small depth tolerance). The curve panel
 //! plots log10 of the loss per iteration, scaled from its minimum (bottom) to its maximum (top);
@@ -15,7 +17,23 @@ use std::path::Path;
 use anyhow::Context;
 use glam::DVec3;
 use roar_mesh::spatial::Normalization;
-use roar_render::{BACKGROUND, Camera, RenderOptions, star_cameras};
+use roar_render::{BACKGROUND, Camera, Image, RenderOptions, star_cameras};
+
+/// What the input row of the picture shows.
+#[derive(Debug, Clone, Copy)]
+pub enum PreviewInput<'a> {
+    /// A soup (any coordinates), rendered here and framed by its own normalization.
+    Soup(&'a [DVec3], &'a [[u32; 3]]),
+    /// Four normal maps of the input already rendered by [`preview_cameras`] at the picture's
+    /// tile size in the rig coordinates of `normalization` (a pixel is the surface where its
+    /// alpha is positive); the output is framed by the same `normalization`.
+    Views {
+        /// Input coordinates to rig coordinates.
+        normalization: Normalization,
+        /// One normal map per camera of [`preview_cameras`], `tile²` pixels each.
+        views: &'a [Image],
+    },
+}
 
 /// Options of [`preview_image`].
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -49,9 +67,9 @@ const OUTPUT_RGB: [f64; 3] = [230.0, 160.0, 90.0];
 pub const WIRE_RGB: [u8; 3] = [40, 40, 40];
 const AXIS_RGB: [u8; 3] = [160, 160, 160];
 
-/// The four views: azimuths 0°, 90°, 180°, 270° at the rig's upper polar angle (30° above the
-/// equator).
-fn preview_cameras(tile: u32) -> Vec<Camera> {
+/// The four views of a picture with tiles of `tile` pixels: azimuths 0°, 90°, 180°, 270° at the
+/// rig's upper polar angle (30° above the equator).
+pub fn preview_cameras(tile: u32) -> Vec<Camera> {
     let all = star_cameras(4, 2, tile, tile);
     (0..4).map(|a| all[a * 2 + 1]).collect()
 }
@@ -59,55 +77,55 @@ fn preview_cameras(tile: u32) -> Vec<Camera> {
 /// The picture of `input` and `output` (plain buffers, any coordinates) and of `losses` (one
 /// per iteration; non-finite values are skipped; an empty slice leaves the panel blank).
 ///
-/// Errors: the input has no extent to frame, or a mesh cannot be rendered (indices out of range,
-/// non-finite coordinates).
+/// Errors: the input soup has no extent to frame, the input views are not four of `tile²`
+/// pixels, or a mesh cannot be rendered (indices out of range, non-finite coordinates).
 pub fn preview_image(
-    input: (&[DVec3], &[[u32; 3]]),
+    input: PreviewInput<'_>,
     output: (&[DVec3], &[[u32; 3]]),
     losses: &[f64],
     options: &PreviewOptions,
 ) -> anyhow::Result<PreviewImage> {
     let tile = options.tile.max(16);
-    let normalization =
-        Normalization::fit(input.0, input.1).context("the input has no extent to frame")?;
     let cameras = preview_cameras(tile);
     let (width, height) = (4 * tile, 3 * tile);
     let mut canvas = Canvas::new(width, height);
-    for (row, (positions, triangles), colour, wire) in
-        [(0, input, INPUT_RGB, false), (1, output, OUTPUT_RGB, true)]
-    {
-        let mut normalized = positions.to_vec();
-        normalization.apply_all(&mut normalized);
-        let render_options = RenderOptions {
-            cull_backfaces: false,
-            antialias: false,
-        };
-        let renders = roar_render::render(&normalized, triangles, &cameras, &render_options)
-            .context("cannot render the preview")?;
-        for (column, (camera, view)) in cameras.iter().zip(&renders.views).enumerate() {
-            let origin = (column as u32 * tile, row * tile);
-            let towards = -camera.position().normalize();
-            for (i, px) in view.rgba.iter().enumerate() {
-                if view.ids[i] == BACKGROUND {
-                    continue;
-                }
-                let n = DVec3::new(px[0] as f64, px[1] as f64, px[2] as f64);
-                let light = 0.25 + 0.75 * n.normalize_or_zero().dot(towards).abs();
-                let rgb = colour.map(|c| (c * light).round().clamp(0.0, 255.0) as u8);
-                let (x, y) = (i as u32 % tile, i as u32 / tile);
-                canvas.put(origin.0 + x, origin.1 + y, rgb);
-            }
-            if wire {
-                draw_wireframe(
-                    &mut canvas,
-                    origin,
-                    camera,
-                    &view.depth,
-                    &normalized,
-                    triangles,
-                );
-            }
+    let normalization = match input {
+        PreviewInput::Soup(positions, triangles) => {
+            let normalization = Normalization::fit(positions, triangles)
+                .context("the input has no extent to frame")?;
+            let mut normalized = positions.to_vec();
+            normalization.apply_all(&mut normalized);
+            let (views, _) = render_views(&normalized, triangles, &cameras)?;
+            shade_row(&mut canvas, 0, &cameras, &views, INPUT_RGB);
+            normalization
         }
+        PreviewInput::Views {
+            normalization,
+            views,
+        } => {
+            let pixels = (tile * tile) as usize;
+            anyhow::ensure!(
+                views.len() == cameras.len() && views.iter().all(|v| v.len() == pixels),
+                "the preview needs {} input views of {tile}×{tile} pixels",
+                cameras.len()
+            );
+            shade_row(&mut canvas, 0, &cameras, views, INPUT_RGB);
+            normalization
+        }
+    };
+    let mut normalized = output.0.to_vec();
+    normalization.apply_all(&mut normalized);
+    let (views, depths) = render_views(&normalized, output.1, &cameras)?;
+    shade_row(&mut canvas, 1, &cameras, &views, OUTPUT_RGB);
+    for (column, (camera, depth)) in cameras.iter().zip(&depths).enumerate() {
+        draw_wireframe(
+            &mut canvas,
+            (column as u32 * tile, tile),
+            camera,
+            depth,
+            &normalized,
+            output.1,
+        );
     }
     draw_curve(&mut canvas, (0, 2 * tile), (width, tile), losses);
     Ok(PreviewImage {
@@ -117,10 +135,60 @@ pub fn preview_image(
     })
 }
 
+/// The normal maps (alpha 1 on the surface, 0 elsewhere) and NDC depth buffers of the cameras'
+/// views of the mesh (rig coordinates).
+fn render_views(
+    positions: &[DVec3],
+    triangles: &[[u32; 3]],
+    cameras: &[Camera],
+) -> anyhow::Result<(Vec<Image>, Vec<Vec<f32>>)> {
+    let render_options = RenderOptions {
+        cull_backfaces: false,
+        antialias: false,
+    };
+    let renders = roar_render::render(positions, triangles, cameras, &render_options)
+        .context("cannot render the preview")?;
+    Ok(renders
+        .views
+        .into_iter()
+        .map(|view| {
+            let rgba = view
+                .rgba
+                .iter()
+                .zip(&view.ids)
+                .map(|(px, &id)| {
+                    let alpha = if id == BACKGROUND { 0.0 } else { 1.0 };
+                    [px[0], px[1], px[2], alpha]
+                })
+                .collect();
+            (rgba, view.depth)
+        })
+        .unzip())
+}
+
+/// Shades the normal maps `views` (one per camera) into picture row `row` with a headlight.
+fn shade_row(canvas: &mut Canvas, row: u32, cameras: &[Camera], views: &[Image], colour: [f64; 3]) {
+    for (column, (camera, rgba)) in cameras.iter().zip(views).enumerate() {
+        let tile = camera.width;
+        let origin = (column as u32 * tile, row * tile);
+        let towards = -camera.position().normalize();
+        for (i, px) in rgba.iter().enumerate() {
+            if px[3] <= 0.0 {
+                continue;
+            }
+            let n = DVec3::new(px[0] as f64, px[1] as f64, px[2] as f64);
+            let light = 0.25 + 0.75 * n.normalize_or_zero().dot(towards).abs();
+            let rgb = colour.map(|c| (c * light).round().clamp(0.0, 255.0) as u8);
+            let (x, y) = (i as u32 % tile, i as u32 / tile);
+            canvas.put(origin.0 + x, origin.1 + y, rgb);
+        }
+    }
+}
+
 /// Computes the picture and writes it as PNG (atomically). See [`preview_image`].
 pub fn write_preview(
     path: &Path,
-    input: (&[DVec3], &[[u32; 3]]),
+    input: PreviewInput<'_>,
     output: (&[DVec3], &[[u32; 3]]),
     losses: &[f64],
     options: &PreviewOptions,

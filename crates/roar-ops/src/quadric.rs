@@ -1,8 +1,9 @@
-//! Garland–Heckbert quadrics and the one small dense solve behind them, for both edge-collapse
+//! Garland–Heckbert quadrics and the one small dense solve behind them (nalgebra's Cholesky), for both edge-collapse
 //! users: the QEM decimation ([`crate::decimate`]) and the loop's QSlim edge costs
 //! ([`crate::blocks::qslim`]).
 
 use glam::DVec3;
+use nalgebra::{Matrix3, Vector3};
 
 /// The error quadric `E(x) = xᵀ A x + 2 bᵀ x + c` of a sum of weighted squared plane distances.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
@@ -61,37 +62,41 @@ impl Quadric {
         (p.dot(ap) + 2.0 * self.b.dot(p) + self.c).max(0.0)
     }
 
-    /// The minimiser of `E`, `x = −A⁻¹ b` (closed-form 3×3 solve by cofactors), or `None` when A
-    /// is (near) singular: `det A ≤ 1e-8 · trace(A)³` (flat or cylindrical neighbourhoods).
-    /// A is positive semi-definite, so `det = λ₁λ₂λ₃` and `trace ≥ λ_max`: every matrix whose
-    /// smallest eigenvalue is below `1e-8` times its largest is rejected.
+    /// The minimiser of `E`, `x = −A⁻¹ b`, or `None` when A is (near) singular:
+    /// `det A ≤ 1e-8 · trace(A)³` (flat or cylindrical neighbourhoods). A is positive
+    /// semi-definite, so `det = λ₁λ₂λ₃` and `trace ≥ λ_max`: every matrix whose smallest
+    /// eigenvalue is below `1e-8` times its largest is rejected.
     pub fn minimizer(&self) -> Option<DVec3> {
         let [xx, xy, xz, yy, yz, zz] = self.a;
         let trace = xx + yy + zz;
         if !(trace > 0.0 && trace.is_finite()) {
             return None;
         }
-        // Cofactors of the symmetric matrix (also the adjugate, by symmetry).
-        let c00 = yy * zz - yz * yz;
-        let c01 = xz * yz - xy * zz;
-        let c02 = xy * yz - xz * yy;
-        let c11 = xx * zz - xz * xz;
-        let c12 = xy * xz - xx * yz;
-        let c22 = xx * yy - xy * xy;
-        let det = xx * c00 + xy * c01 + xz * c02;
-        // NaN fails the comparison and is rejected too.
-        let well_conditioned = det > 1e-8 * trace * trace * trace;
-        if !well_conditioned {
-            return None;
-        }
-        let r = -self.b;
-        let p = DVec3::new(
-            c00 * r.x + c01 * r.y + c02 * r.z,
-            c01 * r.x + c11 * r.y + c12 * r.z,
-            c02 * r.x + c12 * r.y + c22 * r.z,
-        ) / det;
-        p.is_finite().then_some(p)
+        solve_positive_definite(
+            [xx, xy, xz, yy, yz, zz],
+            -self.b,
+            1e-8 * trace * trace * trace,
+        )
     }
+}
+
+/// The solution of `A x = r` for the symmetric A with upper triangle `a` (xx, xy, xz, yy, yz,
+/// zz), by nalgebra's Cholesky factorization `A = L Lᵀ`; `None` unless A is positive definite
+/// with `det A = (l₀₀ l₁₁ l₂₂)² > min_det` and the solution is finite. NaN input is rejected.
+fn solve_positive_definite(a: [f64; 6], r: DVec3, min_det: f64) -> Option<DVec3> {
+    let [xx, xy, xz, yy, yz, zz] = a;
+    let m = Matrix3::new(xx, xy, xz, xy, yy, yz, xz, yz, zz);
+    let cholesky = m.cholesky()?;
+    let l = cholesky.l_dirty();
+    let root_det = l[(0, 0)] * l[(1, 1)] * l[(2, 2)];
+    // NaN fails the comparison and is rejected too.
+    let well_conditioned = root_det * root_det > min_det;
+    if !well_conditioned {
+        return None;
+    }
+    let x = cholesky.solve(&Vector3::new(r.x, r.y, r.z));
+    let p = DVec3::new(x[0], x[1], x[2]);
+    p.is_finite().then_some(p)
 }
 
 /// The upper triangle of `n nᵀ` (xx, xy, xz, yy, yz, zz), as a [`Quadric`] stores its A.
@@ -139,6 +144,56 @@ mod tests {
         assert!(p.distance(corner) < 1e-12);
         assert!(q.eval(p) < 1e-20);
         assert!((q.eval(corner + DVec3::X) - 1.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn minimizer_solves_the_normal_equations_of_tilted_planes() {
+        // Three tilted planes with unequal weights plus a fourth: a full, non-diagonal A.
+        let planes = [
+            (DVec3::new(1.0, 0.2, -0.1), DVec3::new(0.1, 0.0, 0.3), 1.0),
+            (DVec3::new(-0.3, 1.0, 0.4), DVec3::new(0.0, -0.2, 0.1), 2.5),
+            (DVec3::new(0.2, 0.1, 1.0), DVec3::new(0.4, 0.1, -0.3), 0.7),
+            (DVec3::new(1.0, 1.0, 1.0), DVec3::new(0.2, 0.2, 0.2), 0.3),
+        ];
+        let q = planes.iter().fold(Quadric::default(), |q, &(n, p, w)| {
+            q.add(&Quadric::from_plane(n.normalize(), p, w))
+        });
+        let x = q.minimizer().expect("regular");
+        // The gradient 2(Ax + b) vanishes at the minimiser, and E grows in every direction.
+        let [xx, xy, xz, yy, yz, zz] = q.a;
+        let ax = DVec3::new(
+            xx * x.x + xy * x.y + xz * x.z,
+            xy * x.x + yy * x.y + yz * x.z,
+            xz * x.x + yz * x.y + zz * x.z,
+        );
+        assert!(
+            (ax + q.b).length() < 1e-12,
+            "residual {}",
+            (ax + q.b).length()
+        );
+        for d in [DVec3::X, DVec3::Y, DVec3::Z, DVec3::ONE] {
+            assert!(q.eval(x + 1e-3 * d) > q.eval(x));
+            assert!(q.eval(x - 1e-3 * d) > q.eval(x));
+        }
+    }
+
+    #[test]
+    fn two_planes_and_non_finite_quadrics_have_no_minimizer() {
+        let q = Quadric::from_plane(DVec3::X, DVec3::ZERO, 1.0).add(&Quadric::from_plane(
+            DVec3::Y,
+            DVec3::ONE,
+            1.0,
+        ));
+        assert!(q.minimizer().is_none());
+        let nan = Quadric::from_plane(DVec3::new(f64::NAN, 0.0, 1.0), DVec3::ZERO, 1.0)
+            .add(&Quadric::from_plane(DVec3::X, DVec3::ZERO, 1.0))
+            .add(&Quadric::from_plane(DVec3::Y, DVec3::ZERO, 1.0));
+        assert!(nan.minimizer().is_none());
+        // A regular quadric whose smallest eigenvalue is 1e-10 of its largest is rejected too.
+        let thin = Quadric::from_plane(DVec3::X, DVec3::ZERO, 1.0)
+            .add(&Quadric::from_plane(DVec3::Y, DVec3::ZERO, 1.0))
+            .add(&Quadric::from_plane(DVec3::Z, DVec3::ZERO, 1e-10));
+        assert!(thin.minimizer().is_none());
     }
 
     #[test]

@@ -13,7 +13,9 @@ use roar_eval::{EvalOptions, Report};
 use serde::Serialize;
 
 use crate::checks::check_paths;
+use crate::preview::{PreviewInput, PreviewOptions, preview_cameras};
 use glam::DVec3;
+use roar_loss::Shape;
 use roar_mesh::spatial::{Aabb, evaluate_with_gradients};
 
 use crate::pipeline::sdf::{DEFAULT_BOUNDS, SdfReport};
@@ -64,7 +66,8 @@ pub struct ReconstructArgs {
     #[arg(long)]
     pub report: Option<PathBuf>,
     /// Also write a PNG picture: input and output from the same four views (the output with its
-    /// wireframe) and the loss curve of the run.
+    /// wireframe) and the loss curve of the run. The input is the soup, a scan set's aligned
+    /// patches, or an SDF's zero set traced from those views.
     #[arg(long)]
     pub preview: Option<PathBuf>,
     /// Print the effective configuration as TOML and exit.
@@ -239,7 +242,7 @@ pub fn run(args: &ReconstructArgs) -> anyhow::Result<()> {
         args,
         &report,
         &out_soup,
-        Some((&soup.positions, &soup.triangles)),
+        PreviewInput::Soup(&soup.positions, &soup.triangles),
     )
 }
 
@@ -248,7 +251,7 @@ fn write_outputs(
     args: &ReconstructArgs,
     report: &ReconstructReport,
     out_soup: &roar_io::TriangleSoup,
-    input_soup: Option<(&[DVec3], &[[u32; 3]])>,
+    preview_input: PreviewInput<'_>,
 ) -> anyhow::Result<()> {
     let output = args.output.as_ref().context("-o OUTPUT is required")?;
     for failure in &report.run.optimize.untangle_failures {
@@ -266,11 +269,11 @@ fn write_outputs(
         .map(|path| (path.as_path(), json.as_bytes()))
         .collect();
     roar_io::write_mesh_and_files(output, out_soup, &roar_io::WriteOptions::default(), &others)?;
-    if let (Some(preview), Some(input)) = (&args.preview, input_soup) {
+    if let Some(preview) = &args.preview {
         let losses: Vec<f64> = report.run.optimize.history.iter().map(|r| r.loss).collect();
         crate::preview::write_preview(
             preview,
-            input,
+            preview_input,
             (&out_soup.positions, &out_soup.triangles),
             &losses,
             &crate::preview::PreviewOptions::default(),
@@ -305,12 +308,6 @@ fn run_sdf(
     input: &std::path::Path,
     started: Instant,
 ) -> anyhow::Result<()> {
-    if args.preview.is_some() {
-        anyhow::bail!(
-            "--preview pictures a soup input; {} is an SDF",
-            input.display()
-        );
-    }
     let loaded = roar_sdf::load_sdf_input(input, args.bounds.unwrap_or(DEFAULT_BOUNDS))
         .map_err(|e| anyhow::anyhow!("{}: {e}", input.display()))?;
     let field = loaded.field;
@@ -324,6 +321,12 @@ fn run_sdf(
         .with_context(|| format!("{}: reconstruction failed", input.display()));
     progress.finish();
     let result = result?;
+    // Traced before the report, so the report counts the preview's evaluations.
+    let preview_views = args
+        .preview
+        .as_ref()
+        .map(|_| shape.preview_views(&preview_cameras(PreviewOptions::default().tile)))
+        .unwrap_or_default();
     let evaluations = shape.report();
     let (values, gradients) = evaluate_with_gradients(field.as_ref(), &result.positions);
     let distances: Vec<f64> = values
@@ -358,7 +361,11 @@ fn run_sdf(
             output_distance_max: distances.iter().copied().fold(0.0, f64::max),
         }),
     };
-    write_outputs(args, &report, &out_soup, None)
+    let preview_input = PreviewInput::Views {
+        normalization: shape.normalization(),
+        views: &preview_views,
+    };
+    write_outputs(args, &report, &out_soup, preview_input)
 }
 
 /// `defaults` overridden by the keys of the TOML file at `path`, if any; a parse error or an

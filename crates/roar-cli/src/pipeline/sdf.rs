@@ -31,8 +31,8 @@ pub const DEFAULT_BOUNDS: Aabb = roar_sdf::DEFAULT_BOUNDS;
 #[derive(Clone, Debug, Default, Serialize)]
 pub struct SdfReport {
     /// Points evaluated for values, by stage: `trace` (the target renders), `init` (the voxel
-    /// init), `point_cloud`, and `loop` (everything after: the SDF loss and the Face Split
-    /// projector).
+    /// init), `point_cloud`, `loop` (the SDF loss and the Face Split projector), and `preview`
+    /// (the `--preview` picture's input views, when asked for).
     pub values: BTreeMap<&'static str, u64>,
     /// Points evaluated for values and gradients, by the same stages.
     pub gradients: BTreeMap<&'static str, u64>,
@@ -142,6 +142,19 @@ impl SdfShape {
             trace.seconds += stats.seconds;
         }
         images
+    }
+
+    /// Normal maps of the zero set seen by `cameras` (rig coordinates: the frame of
+    /// [`Shape::normalization`]), traced as the target renders are; for the preview picture.
+    /// The field's evaluations are charged to stage `preview`.
+    pub fn preview_views(&self, cameras: &[Camera]) -> Vec<Image> {
+        let options = TraceOptions {
+            grid_resolution: self.config.target.sdf_trace_grid,
+            refine_steps: self.config.target.sdf_trace_refine_steps,
+        };
+        self.counted("preview", || {
+            roar_sdf::trace_normal_maps(self.rig.as_ref(), &self.rig_bounds(), cameras, &options).0
+        })
     }
 
     /// The field's evaluations by stage so far, for the report (what no stage claimed is
