@@ -87,20 +87,9 @@ fn the_flag_refuses_a_non_png_name_before_any_work() {
         input: Some(input),
         output: Some(dir.path().join("out.obj")),
         faces: Some(200),
-        config: None,
-        init: None,
-        iterations: None,
-        resolution: None,
-        seed: None,
-        best_effort: false,
-        no_icp: false,
-        report: None,
         preview: Some(dir.path().join("preview.jpg")),
-        print_config: false,
         quiet: true,
-        force: false,
-        keep_topology: false,
-        bounds: None,
+        ..Default::default()
     };
     let message = roar_cli::commands::reconstruct::run(&args)
         .unwrap_err()
@@ -122,19 +111,9 @@ fn reconstruct_with_preview(dir: &Path, input: PathBuf, faces: usize) -> anyhow:
         output: Some(dir.join("out.obj")),
         faces: Some(faces),
         config: Some(config_path),
-        init: None,
-        iterations: None,
-        resolution: None,
-        seed: None,
-        best_effort: false,
-        no_icp: false,
-        report: None,
         preview: Some(preview.clone()),
-        print_config: false,
         quiet: true,
-        force: false,
-        keep_topology: false,
-        bounds: None,
+        ..Default::default()
     };
     roar_cli::commands::reconstruct::run(&args)?;
     Ok(preview)

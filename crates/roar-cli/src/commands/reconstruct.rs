@@ -25,7 +25,7 @@ use crate::pipeline::{
 };
 
 /// Arguments of `roar reconstruct`.
-#[derive(Args, Debug)]
+#[derive(Args, Debug, Default)]
 pub struct ReconstructArgs {
     /// Any triangle soup (OBJ, PLY, STL or OFF; a PLY range image is its patch), a set of range
     /// scans (a Stanford `.conf` or the folder holding one; `docs/scans.md`), or a signed

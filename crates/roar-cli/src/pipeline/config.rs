@@ -432,32 +432,21 @@ impl ReconstructConfig {
     /// Errors are one line: a key of another table (or a flat key of the ungrouped layout) names
     /// the table it belongs in, a bad value its line. Does not [`validate`](Self::validate).
     pub fn from_toml(text: &str, defaults: &Self) -> Result<Self, String> {
-        let one_line = |e: toml::de::Error| e.to_string().replace('\n', " ").trim().to_string();
         let file: toml::Table = toml::from_str(text).map_err(one_line)?;
         check_layout(&file)?;
         // Parsed alone, so a bad value is named with its line in the file.
         toml::from_str::<Self>(text).map_err(one_line)?;
-        Self::from_table(file, defaults)
+        merge_over(file, defaults)
     }
 
     /// Like [`from_toml`](Self::from_toml) for a table already parsed (the Python package's dict).
     pub fn from_table(file: toml::Table, defaults: &Self) -> Result<Self, String> {
         check_layout(&file)?;
-        let mut merged = toml::Table::try_from(defaults).map_err(|e| e.to_string())?;
-        for (key, value) in file {
-            match (merged.get_mut(&key), value) {
-                (Some(toml::Value::Table(table)), toml::Value::Table(keys)) => table.extend(keys),
-                (_, value) => {
-                    merged.insert(key, value);
-                }
-            }
-        }
-        merged
-            .try_into()
-            .map_err(|e: toml::de::Error| e.to_string().replace('\n', " ").trim().to_string())
+        merge_over(file, defaults)
     }
 
-    /// Every numeric field with its allowed range and its current value, in declaration order.
+    /// Every numeric field with its allowed range and its current value, named as the messages
+    /// name it (`loss.render_weight`).
     /// The ranges are wide: they refuse what cannot mean anything (NaN, infinities, negative
     /// weights, zero samples, huge values that would exhaust memory or time), not what is merely
     /// unusual. `0 (off)` marks the fields where 0 switches a feature off, as their docs say.
@@ -634,6 +623,29 @@ impl ReconstructConfig {
             ),
         ]
     }
+}
+
+/// A TOML error on one line, for the CLI's one-line messages.
+fn one_line(e: toml::de::Error) -> String {
+    e.to_string().replace('\n', " ").trim().to_string()
+}
+
+/// `defaults` with the keys of `file` over them, table by table (a file's `[optimize]` replaces
+/// only the keys it names).
+fn merge_over(
+    file: toml::Table,
+    defaults: &ReconstructConfig,
+) -> Result<ReconstructConfig, String> {
+    let mut merged = toml::Table::try_from(defaults).map_err(|e| e.to_string())?;
+    for (key, value) in file {
+        match (merged.get_mut(&key), value) {
+            (Some(toml::Value::Table(table)), toml::Value::Table(keys)) => table.extend(keys),
+            (_, value) => {
+                merged.insert(key, value);
+            }
+        }
+    }
+    merged.try_into().map_err(one_line)
 }
 
 /// Refuses a key outside the table it belongs in, naming that table: the flat keys of the
