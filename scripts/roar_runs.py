@@ -1,0 +1,37 @@
+"""Helpers the evaluation scripts share: run a command under /usr/bin/time, and read the figures
+of a table from `roar eval --json`. Plain python3, no packages."""
+
+import json
+import subprocess
+import time
+
+
+def timed(cmd, **kwargs):
+    """Runs `cmd` under /usr/bin/time -v; returns (completed process, seconds, peak bytes)."""
+    started = time.perf_counter()
+    proc = subprocess.run(["/usr/bin/time", "-v"] + cmd, capture_output=True, text=True, **kwargs)
+    seconds = time.perf_counter() - started
+    peak = None
+    for line in proc.stderr.splitlines():
+        if "Maximum resident set size" in line:
+            peak = int(line.split(":")[1]) * 1024
+    return proc, seconds, peak
+
+
+def evaluate(roar, mesh, ref):
+    """The figures of the table from `roar eval MESH --ref REF --json`."""
+    proc = subprocess.run([roar, "eval", mesh, "--ref", ref, "--json"], capture_output=True, text=True)
+    if proc.returncode != 0:
+        return {"error": proc.stderr.strip()}
+    r = json.loads(proc.stdout)
+    topo = r["topology_welded"]
+    return {
+        "faces": topo["faces"],
+        "closed": bool(topo["watertight"]),
+        "genus": topo.get("genus"),
+        "components": topo["components"],
+        "self_intersecting_faces": (r.get("self_intersections") or {}).get("faces"),
+        "signed_volume": (r.get("orientation") or {}).get("signed_volume"),
+        "chamfer_over_diag": r["fidelity"]["chamfer_l2_over_diag"],
+        "normal_cosine": r["fidelity"]["normal_cosine"],
+    }
