@@ -18,14 +18,12 @@ pub struct QualityStats {
     pub degenerate: usize,
 }
 
-/// `Q = R/(2r) = abc / (8(s−a)(s−b)(s−c))` of one triangle: 1 for an equilateral triangle, larger
-/// for worse shapes. `None` when the triangle has zero area (Q infinite) or non-finite corners.
+/// `Q = R/(2r)` of one triangle (`roar_mesh::spatial::triangle_quality`): 1 for an equilateral
+/// triangle, larger for worse shapes. `None` when the triangle has zero area (Q infinite or
+/// undefined) or non-finite corners.
 pub fn aspect_ratio(a: DVec3, b: DVec3, c: DVec3) -> Option<f64> {
-    let (la, lb, lc) = (b.distance(c), c.distance(a), a.distance(b));
-    let s = 0.5 * (la + lb + lc);
-    let denom = 8.0 * (s - la) * (s - lb) * (s - lc);
-    let q = la * lb * lc / denom;
-    (denom > 0.0 && q.is_finite()).then_some(q)
+    let q = roar_mesh::spatial::triangle_quality([a, b, c]);
+    q.is_finite().then_some(q)
 }
 
 /// Linear-interpolation percentile of sorted values, `p` in [0, 1].

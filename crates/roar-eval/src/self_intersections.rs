@@ -52,25 +52,8 @@ pub struct SelfIntersectionStats {
     pub offset: f64,
 }
 
-/// Unit area-weighted vertex normals: the normalized sum of the cross products `(b−a)×(c−a)` of
-/// the incident non-degenerate faces (zero where they cancel or there are none).
-pub fn area_weighted_vertex_normals(positions: &[DVec3], triangles: &[[u32; 3]]) -> Vec<DVec3> {
-    let mut normals = vec![DVec3::ZERO; positions.len()];
-    for t in triangles {
-        if t[0] == t[1] || t[1] == t[2] || t[2] == t[0] {
-            continue;
-        }
-        let [a, b, c] = t.map(|i| positions[i as usize]);
-        let n = (b - a).cross(c - a);
-        for &i in t {
-            normals[i as usize] += n;
-        }
-    }
-    for n in &mut normals {
-        *n = n.normalize_or_zero();
-    }
-    normals
-}
+/// Unit area-weighted vertex normals (`roar_mesh::spatial`), along which the ε offset moves.
+pub use roar_mesh::spatial::area_weighted_vertex_normals;
 
 /// Counts self-intersecting faces of `(positions, triangles)` **as given**: callers weld first
 /// (see the module rules; [`crate::evaluate`] does). Indices must be in range and coordinates

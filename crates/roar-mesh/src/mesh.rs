@@ -262,13 +262,8 @@ impl Mesh {
 
     /// Unit normal of `f`; faces with `|cross| <= 1e-9` get `(1, 0, 0)` (spec §2.2).
     pub fn face_normal(&self, f: FaceId) -> DVec3 {
-        let n = self.face_cross(f);
-        let len = n.length();
-        if len > DEGENERATE_CROSS && len.is_finite() {
-            n / len
-        } else {
-            DEGENERATE_NORMAL
-        }
+        let [a, b, c] = self.face_vertices(f).map(|v| self.position(v));
+        crate::spatial::triangle_normal(a, b, c)
     }
 
     /// Area of `f`, clamped below at `1e-9` as in spec §2.2.

@@ -1,56 +1,17 @@
 //! Per-block geometry snapshots on the half-edge mesh (spec §2.2): face normals and areas, ROAR
-//! vertex normals (area × corner-angle weights), the normal magnitude μ_v, face folds φ_f and
-//! triangle quality Q. Computed once per block call into `Vec`s indexed by element id (slot),
+//! vertex normals (the area × corner-angle weights of `roar_mesh::spatial`), the normal
+//! magnitude μ_v and face folds φ_f. Computed once per block call into `Vec`s indexed by element id (slot),
 //! dead slots hold zeros.
 
-use roar_mesh::{DEGENERATE_CROSS, DEGENERATE_NORMAL, DVec3, EdgeId, Mesh, VertexId};
+use roar_mesh::spatial::area_angle_weights;
+use roar_mesh::{DEGENERATE_CROSS, DVec3, EdgeId, Mesh, VertexId};
 
-/// Unit normal of triangle `(a, b, c)` with the spec's degenerate rule: `|cross| ≤ 1e-9` gives
-/// `(1, 0, 0)` (spec §2.2).
-pub fn triangle_normal(a: DVec3, b: DVec3, c: DVec3) -> DVec3 {
-    let n = (b - a).cross(c - a);
-    let len = n.length();
-    if len > DEGENERATE_CROSS && len.is_finite() {
-        n / len
-    } else {
-        DEGENERATE_NORMAL
-    }
-}
-
-/// Interior angles of triangle `p` at its three corners, from the clipped cosine (spec §2.2).
-/// A corner with a zero-length side gets π/2 (its cosine is taken as 0).
-pub fn corner_angles(p: [DVec3; 3]) -> [f64; 3] {
-    std::array::from_fn(|k| {
-        let u = (p[(k + 1) % 3] - p[k]).normalize_or_zero();
-        let v = (p[(k + 2) % 3] - p[k]).normalize_or_zero();
-        u.dot(v).clamp(-1.0, 1.0).acos()
-    })
-}
-
-/// Triangle quality `Q = abc / (8 (s−a)(s−b)(s−c))` (spec §2.2): 1 for an equilateral
-/// triangle, growing without bound for slivers (+∞ for a collinear triangle with non-zero
-/// sides). A fully collapsed triangle (0/0) returns NaN; callers decide (collapse simulation
-/// counts NaN as 1).
-pub fn triangle_quality(p: [DVec3; 3]) -> f64 {
-    let a = p[1].distance(p[2]);
-    let b = p[2].distance(p[0]);
-    let c = p[0].distance(p[1]);
-    let s = 0.5 * (a + b + c);
-    let den = 8.0 * (s - a) * (s - b) * (s - c);
-    let num = a * b * c;
-    if den <= 0.0 {
-        if num > 0.0 { f64::INFINITY } else { f64::NAN }
-    } else {
-        num / den
-    }
-}
-
-/// The quality (`Q = R/(2r)`, see [`triangle_quality`]) from which a face counts as degenerate,
+/// The aspect ratio (`roar_mesh::spatial::triangle_quality`) from which a face counts as degenerate,
 /// the default of the QEM, the sliver flips, the degenerate collapses and the pipeline's fill:
 /// above it a face's normal is rounding noise.
 pub const DEGENERATE_QUALITY: f64 = 100.0;
 
-/// Whether a triangle of quality `q` (see [`triangle_quality`]) is degenerate: at or above
+/// Whether a triangle of aspect ratio `q` (`roar_mesh::spatial::triangle_quality`) is degenerate: at or above
 /// `limit`, or NaN (fully collapsed). Such a face's normal is rounding noise, which the sliver
 /// flips and the degenerate collapses must not trust.
 pub fn is_degenerate(q: f64, limit: f64) -> bool {
@@ -108,15 +69,13 @@ impl Geometry {
         for f in mesh.faces() {
             let vs = mesh.face_vertices(f);
             let p = vs.map(|v| mesh.position(v));
-            let n = triangle_normal(p[0], p[1], p[2]);
-            let area = (0.5 * (p[1] - p[0]).cross(p[2] - p[0]).length()).max(DEGENERATE_CROSS);
+            let (n, weights) = area_angle_weights(p);
             g.face_normals[f.index()] = n;
-            g.face_areas[f.index()] = area;
-            let angles = corner_angles(p);
+            g.face_areas[f.index()] =
+                (0.5 * (p[1] - p[0]).cross(p[2] - p[0]).length()).max(DEGENERATE_CROSS);
             for k in 0..3 {
-                let w = area * angles[k];
-                g.vertex_normals_raw[vs[k].index()] += w * n;
-                weight_sum[vs[k].index()] += w;
+                g.vertex_normals_raw[vs[k].index()] += weights[k] * n;
+                weight_sum[vs[k].index()] += weights[k];
             }
         }
         for v in mesh.vertices() {
@@ -166,21 +125,6 @@ mod tests {
     use roar_mesh::shapes::icosphere;
 
     #[test]
-    fn quality_of_equilateral_is_one_and_slivers_grow() {
-        let eq = [
-            DVec3::ZERO,
-            DVec3::X,
-            DVec3::new(0.5, 3f64.sqrt() / 2.0, 0.0),
-        ];
-        assert!((triangle_quality(eq) - 1.0).abs() < 1e-12);
-        let sliver = [DVec3::ZERO, DVec3::X, DVec3::new(0.5, 0.01, 0.0)];
-        assert!(triangle_quality(sliver) > 10.0);
-        let line = [DVec3::ZERO, DVec3::X, DVec3::new(2.0, 0.0, 0.0)];
-        assert_eq!(triangle_quality(line), f64::INFINITY);
-        assert!(triangle_quality([DVec3::ONE; 3]).is_nan());
-    }
-
-    #[test]
     fn sphere_normals_point_outward_with_unit_magnitude() {
         let mesh = icosphere(2);
         let g = Geometry::compute(&mesh);
@@ -192,16 +136,5 @@ mod tests {
         }
         let folds = g.face_folds(&mesh);
         assert!(mesh.faces().all(|f| folds[f.index()].abs() < 0.02));
-    }
-
-    #[test]
-    fn angles_sum_to_pi() {
-        let p = [
-            DVec3::ZERO,
-            DVec3::new(2.0, 0.1, 0.0),
-            DVec3::new(0.3, 1.0, 0.5),
-        ];
-        let a = corner_angles(p);
-        assert!((a.iter().sum::<f64>() - std::f64::consts::PI).abs() < 1e-12);
     }
 }

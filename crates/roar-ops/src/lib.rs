@@ -14,9 +14,10 @@
 //!
 //! Before the stages, for range scans: [`align`] (trimmed point-to-plane ICP of scan patches).
 //!
-//! Shared by several stages: [`geometry`] (per-mesh normals, quality measures), [`quadric`] (the
-//! error quadrics of the decimation and of the QSlim edge costs) and a private
-//! exact face–face intersection test. Dependencies run down this table's stages and into the
+//! Shared by several stages: [`geometry`] (per-mesh normals, folds, flip tests) and [`quadric`]
+//! (the error quadrics of the decimation and of the QSlim edge costs); the geometric kernels
+//! (triangle quality, vertex normals, the filtered exact face–face test) are
+//! `roar_mesh::spatial`'s. Dependencies run down this table's stages and into the
 //! shared modules; no two modules import each other.
 
 pub mod align;
@@ -34,5 +35,4 @@ pub mod untangle;
 pub mod finish;
 
 pub mod geometry;
-mod intersect;
 pub mod quadric;

@@ -8,10 +8,11 @@ use blocks_common::random_mesh;
 use proptest::prelude::*;
 use roar_mesh::shapes::icosphere;
 use roar_mesh::spatial::count_intersecting_faces;
+use roar_mesh::spatial::triangle_quality;
 use roar_mesh::{EdgeId, Mesh, VertexId};
 use roar_ops::finish::degenerate::{DegenerateOptions, collapse_degenerate_faces};
 use roar_ops::finish::slivers::{SliverOptions, flip_slivers};
-use roar_ops::geometry::{DEGENERATE_QUALITY, is_degenerate, triangle_quality};
+use roar_ops::geometry::{DEGENERATE_QUALITY, is_degenerate};
 
 fn degenerate_faces(mesh: &Mesh) -> usize {
     mesh.faces()

@@ -203,7 +203,7 @@ fn gridded_box(cells: [usize; 3], size: [f64; 3]) -> Mesh {
 fn aspect_percentiles(m: &Mesh) -> [f64; 3] {
     let mut q: Vec<f64> = m
         .faces()
-        .map(|f| roar_ops::decimate::triangle_quality(m.face_vertices(f).map(|v| m.position(v))))
+        .map(|f| roar_mesh::spatial::triangle_quality(m.face_vertices(f).map(|v| m.position(v))))
         .collect();
     q.sort_by(f64::total_cmp);
     [q[q.len() / 2], q[q.len() * 95 / 100], q[q.len() - 1]]

@@ -9,9 +9,9 @@ use blocks_common::{random_mesh, worst_quality};
 use proptest::prelude::*;
 use roar_mesh::shapes::{cube, icosphere};
 use roar_mesh::spatial::count_intersecting_faces;
+use roar_mesh::spatial::triangle_quality;
 use roar_mesh::{FaceId, Mesh};
 use roar_ops::finish::slivers::{SliverOptions, flip_slivers};
-use roar_ops::geometry::triangle_quality;
 
 /// Splits `f` at a point close to the middle of its first edge: a cap (one angle near 180°).
 fn plant_cap(mesh: &mut Mesh, f: FaceId, closeness: f64) {

@@ -394,8 +394,9 @@ mod tests {
     use roar_mesh::shapes::icosphere;
     use roar_mesh::spatial::Aabb;
     use roar_mesh::spatial::count_intersecting_faces;
+    use roar_mesh::spatial::triangle_quality;
     use roar_ops::finish::fill::bisects_well;
-    use roar_ops::geometry::{DEGENERATE_QUALITY, is_degenerate, triangle_quality};
+    use roar_ops::geometry::{DEGENERATE_QUALITY, is_degenerate};
 
     /// Faces at or above [`DEGENERATE_QUALITY`].
     fn degenerate_faces(mesh: &Mesh) -> usize {
@@ -545,12 +546,12 @@ mod tests {
 
     #[test]
     fn the_run_finishes_from_the_lowest_loss_state_the_untangle_clears() {
-        // A sphere scrambled into a tangle the untangle cannot clear, with the lowest loss.
-        let mut tangle = icosphere(2);
-        for (k, p) in tangle.positions_mut().iter_mut().enumerate() {
-            let t = k as f64;
-            *p = DVec3::new((1.7 * t).sin(), (2.3 * t).cos(), (3.1 * t).sin());
-        }
+        // Two copies of one tetrahedron on top of each other, every face overlapping its copy
+        // and no edge collapsible: a tangle the untangle cannot clear, with the lowest loss.
+        let corners = [DVec3::ZERO, DVec3::X, DVec3::Y, DVec3::Z];
+        let faces = [[0, 2, 1], [0, 1, 3], [1, 2, 3], [0, 3, 2]];
+        let copy = faces.map(|f: [u32; 3]| f.map(|v| v + 4));
+        let tangle = Mesh::from_triangles(corners.repeat(2), &[faces, copy].concat()).unwrap();
         let state = |iteration, loss, mesh: &Mesh| LoopState {
             iteration,
             loss,

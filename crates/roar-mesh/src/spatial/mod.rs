@@ -10,15 +10,18 @@
 //!
 //! Modules: [`aabb`] (boxes), [`normalization`] (into the rig sphere and back),
 //! [`point_triangle`] (one-triangle closest point and ray hit), [`bvh`] (the triangle tree),
-//! [`tri_tri`] (exact triangle–triangle tests), [`self_intersections`], [`sampling`]
+//! [`tri_tri`] (exact triangle–triangle tests), [`filtered_tri_tri`] (the same behind certified
+//! floating-point filters, for many pairs), [`self_intersections`], [`sampling`]
 //! (area-weighted random samples),
 //! [`winding`] (fast winding numbers), [`regular_sampling`] (regular per-face grids),
 //! [`projector`] (the `Projector` trait), [`ray_projector`] (exact ray-cast projection, §3.4 (B)),
-//! [`vertex_normals`](mod@vertex_normals) (the ROAR vertex normals, §2.2), [`sdf`] (the `Sdf` trait
+//! [`triangle`] (one triangle's normal, angles and aspect ratio),
+//! [`vertex_normals`](mod@vertex_normals) (vertex normals by named weightings, §2.2), [`sdf`] (the `Sdf` trait
 //! of signed distance inputs), [`isosurface`] (marching tetrahedra over a grid of values).
 
 pub mod aabb;
 pub mod bvh;
+pub mod filtered_tri_tri;
 pub mod isosurface;
 pub mod normalization;
 pub mod point_triangle;
@@ -29,11 +32,15 @@ pub mod sampling;
 pub mod sdf;
 pub mod self_intersections;
 pub mod tri_tri;
+pub mod triangle;
 pub mod vertex_normals;
 pub mod winding;
 
 pub use aabb::Aabb;
 pub use bvh::{CertifiedClosest, ClosestPoint, RayHit, TriangleBvh};
+pub use filtered_tri_tri::{
+    PreparedFace, certainly_apart, faces_intersect_filtered, fan_is_embedded,
+};
 pub use isosurface::marching_tetrahedra;
 pub use normalization::{Normalization, RIG_RADIUS};
 pub use point_triangle::{closest_point_on_triangle, ray_triangle};
@@ -52,7 +59,8 @@ pub use self_intersections::{
     count_intersecting_faces, face_intersects_any, intersecting_pairs, self_intersecting_faces,
 };
 pub use tri_tri::{faces_intersect, segment_intersects_triangle, triangles_intersect};
-pub use vertex_normals::vertex_normals;
+pub use triangle::{corner_angles, triangle_normal, triangle_quality};
+pub use vertex_normals::{area_angle_weights, area_weighted_vertex_normals, vertex_normals};
 pub use winding::{
     TriangleIndexError, WindingNumber, WindingNumberOptions, exact_winding_number,
     triangle_solid_angle,

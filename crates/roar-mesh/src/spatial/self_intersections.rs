@@ -14,7 +14,7 @@ use rayon::prelude::*;
 
 use super::aabb::Aabb;
 use super::bvh::TriangleBvh;
-use super::tri_tri::faces_intersect;
+use super::filtered_tri_tri::faces_intersect_filtered as faces_intersect;
 use crate::Mesh;
 
 /// Faces per parallel work item (small meshes run on one thread).

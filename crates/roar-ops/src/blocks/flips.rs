@@ -17,7 +17,7 @@
 
 use crate::blocks::block::{Block, BlockContext, BlockStats};
 use crate::blocks::guard::IntersectionGuard;
-use crate::geometry::triangle_normal;
+use roar_mesh::spatial::triangle_normal;
 use roar_mesh::{EdgeId, Mesh, TrackedMesh};
 
 /// Options of [`flip_edges`] (spec §3.7).

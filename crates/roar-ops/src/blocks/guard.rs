@@ -12,11 +12,11 @@
 //! (the caller reports them with [`IntersectionGuard::mark_around`] /
 //! [`IntersectionGuard::mark`]); their BVH entries are ignored, and they are instead tested
 //! from a short list with their current corners. Every test is
-//! [`crate::intersect::faces_intersect_filtered`], exact behind certified filters.
+//! [`roar_mesh::spatial::faces_intersect_filtered`], exact behind certified filters.
 
 use crate::blocks::block::BlockStats;
-use crate::intersect::faces_intersect_filtered;
 use glam::DVec3;
+use roar_mesh::spatial::faces_intersect_filtered;
 use roar_mesh::spatial::{Aabb, TriangleBvh};
 use roar_mesh::{EdgeId, FaceId, HalfedgeId, Mesh, VertexId};
 

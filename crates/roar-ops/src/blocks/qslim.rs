@@ -7,8 +7,9 @@
 //! collapsing edge (a, b) onto endpoint position p is `pᵀ(A_a+A_b)p + 2(b_a+b_b)·p + c_a+c_b`,
 //! clamped at 0; placements are the two endpoints only (half-edge collapse).
 
-use crate::geometry::{Geometry, triangle_quality};
+use crate::geometry::Geometry;
 use crate::quadric::Quadric;
+use roar_mesh::spatial::triangle_quality;
 use roar_mesh::{DEGENERATE_CROSS, DVec3, EdgeId, HalfedgeId, Mesh, VertexId};
 
 /// How the vertex plane's "generalized normal" blends the vertex normal with the Laplacian

@@ -127,8 +127,8 @@ impl Block for TangentialSmoothing {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::decimate::triangle_quality;
     use roar_mesh::shapes::icosphere;
+    use roar_mesh::spatial::triangle_quality;
 
     /// An icosphere whose vertices slid along the sphere by up to `amount` of the radius, so
     /// its triangles are uneven but it stays on the unit sphere (to its chords).

@@ -627,9 +627,9 @@ impl Block for FaceSplit {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::geometry::corner_angles;
     use rand::Rng;
     use roar_mesh::shapes::icosphere;
+    use roar_mesh::spatial::corner_angles;
     use roar_mesh::spatial::regular_samples;
 
     /// The direct reading of §3.5 steps 1–4 (unit normals, `acos` corner angles), the brute-force

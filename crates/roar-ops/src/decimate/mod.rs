@@ -39,12 +39,14 @@ mod heap;
 mod split;
 
 use crate::geometry::is_degenerate;
-use crate::intersect::{PreparedFace, certainly_apart, faces_intersect_filtered, fan_is_embedded};
 use crate::quadric::{Quadric, placement};
 use glam::DVec3;
 use grid::{Box32, FaceGrid};
 use heap::EdgeHeap;
-use roar_mesh::spatial::Aabb;
+use roar_mesh::spatial::{Aabb, triangle_quality};
+use roar_mesh::spatial::{
+    PreparedFace, certainly_apart, faces_intersect_filtered, fan_is_embedded,
+};
 use roar_mesh::{Collapse, EdgeId, FaceId, HalfedgeId, Mesh, Remap, VertexId};
 use std::fmt;
 
@@ -439,16 +441,6 @@ enum Verdict {
     /// Put it back with its cost multiplied by this quality penalty (> 1).
     Penalize(f64),
     Refuse(Veto),
-}
-
-/// Aspect ratio `Q = R/(2r) = abc·s/(8K²)` (1 for equilateral, ∞ for degenerate).
-pub fn triangle_quality([p0, p1, p2]: [DVec3; 3]) -> f64 {
-    let (a, b, c) = (p1.distance(p2), p2.distance(p0), p0.distance(p1));
-    let k = 0.5 * (p1 - p0).cross(p2 - p0).length();
-    if k <= 0.0 {
-        return f64::INFINITY;
-    }
-    a * b * c * (0.5 * (a + b + c)) / (8.0 * k * k)
 }
 
 struct Decimator<'m, F: FnMut(&Collapse)> {
@@ -942,22 +934,6 @@ impl<'m, F: FnMut(&Collapse)> Decimator<'m, F> {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn quality_is_one_for_equilateral_and_grows_for_slivers() {
-        let eq = [
-            DVec3::ZERO,
-            DVec3::X,
-            DVec3::new(0.5, 3f64.sqrt() / 2.0, 0.0),
-        ];
-        assert!((triangle_quality(eq) - 1.0).abs() < 1e-12);
-        let sliver = [DVec3::ZERO, DVec3::X, DVec3::new(0.5, 0.01, 0.0)];
-        assert!(triangle_quality(sliver) > 20.0);
-        assert_eq!(
-            triangle_quality([DVec3::ZERO, DVec3::X, 2.0 * DVec3::X]),
-            f64::INFINITY
-        );
-    }
 
     #[test]
     fn near_face_is_prepared_once_from_its_corners() {

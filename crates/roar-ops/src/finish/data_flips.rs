@@ -39,9 +39,10 @@
 
 use crate::blocks::block::BlockStats;
 use crate::blocks::guard::{IntersectionGuard, flip_if_clean};
-use crate::geometry::{flip_keeps_orientation, flip_quad, triangle_quality};
+use crate::geometry::{flip_keeps_orientation, flip_quad};
 use glam::DVec3;
 use rayon::prelude::*;
+use roar_mesh::spatial::triangle_quality;
 use roar_mesh::{EdgeId, Mesh};
 
 /// Options of [`flip_toward_target`].

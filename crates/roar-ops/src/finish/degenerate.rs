@@ -34,7 +34,8 @@
 
 use crate::blocks::block::BlockStats;
 use crate::blocks::guard::IntersectionGuard;
-use crate::geometry::{DEGENERATE_QUALITY, is_degenerate, triangle_normal, triangle_quality};
+use crate::geometry::{DEGENERATE_QUALITY, is_degenerate};
+use roar_mesh::spatial::{triangle_normal, triangle_quality};
 use roar_mesh::{FaceId, HalfedgeId, Mesh};
 
 /// Options of [`collapse_degenerate_faces`].

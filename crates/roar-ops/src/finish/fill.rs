@@ -4,7 +4,8 @@
 
 use roar_mesh::{EdgeId, Mesh};
 
-use crate::geometry::{DEGENERATE_QUALITY, is_degenerate, triangle_quality};
+use crate::geometry::{DEGENERATE_QUALITY, is_degenerate};
+use roar_mesh::spatial::triangle_quality;
 
 /// Splits edges at their midpoints until the mesh has `faces` faces (each split adds two),
 /// longest first, skipping edges whose halving would leave a degenerate face

@@ -34,11 +34,10 @@
 
 use crate::blocks::block::BlockStats;
 use crate::blocks::guard::{IntersectionGuard, flip_if_clean};
-use crate::geometry::{
-    flip_keeps_orientation, flip_quad, is_degenerate, triangle_normal, triangle_quality,
-};
+use crate::geometry::{flip_keeps_orientation, flip_quad, is_degenerate};
 use glam::DVec3;
 use roar_mesh::Mesh;
+use roar_mesh::spatial::{triangle_normal, triangle_quality};
 
 /// Options of [`flip_slivers`].
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -5,9 +5,10 @@
 //! and the piece count are kept) and a simulation on the current buffers shows that it strictly
 //! lowers the number of intersecting pairs around it and flips no remaining face.
 
-use crate::intersect::faces_intersect_filtered as faces_cross;
+use crate::geometry::{DEGENERATE_QUALITY, is_degenerate};
 use glam::DVec3;
-use roar_mesh::spatial::{Aabb, TriangleBvh};
+use roar_mesh::spatial::faces_intersect_filtered as faces_cross;
+use roar_mesh::spatial::{Aabb, TriangleBvh, triangle_quality};
 use roar_mesh::{FaceId, HalfedgeId, Mesh, VertexId};
 
 /// The working buffers of [`super::untangle`]: slot positions, live triangles (slot indices),
@@ -45,17 +46,6 @@ impl Buffers {
             index_of,
             adjacency,
         }
-    }
-}
-
-/// Shape quality `4√3·area / Σ edge²` of a triangle: 1 equilateral, 0 degenerate.
-pub(super) fn quality([a, b, c]: [DVec3; 3]) -> f64 {
-    let area2 = (b - a).cross(c - a).length();
-    let sum = a.distance_squared(b) + b.distance_squared(c) + c.distance_squared(a);
-    if sum > 0.0 {
-        2.0 * 3f64.sqrt() * area2 / sum
-    } else {
-        0.0
     }
 }
 
@@ -174,7 +164,9 @@ fn collapse_helps(
     for (t, n_old) in new_faces.iter().zip(&olds) {
         let [p, q, r] = t.map(|i| positions[i as usize]);
         let n_new = (q - p).cross(r - p);
-        if n_new.dot(*n_old) <= 0.0 || quality([p, q, r]) < 1e-3 {
+        if n_new.dot(*n_old) <= 0.0
+            || is_degenerate(triangle_quality([p, q, r]), DEGENERATE_QUALITY)
+        {
             return false;
         }
     }

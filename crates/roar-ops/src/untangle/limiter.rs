@@ -1,9 +1,9 @@
 //! The step limiter: shortens optimizer steps that would create a self-intersection.
 
-use crate::intersect::{PreparedFace, certainly_apart, faces_intersect_filtered as faces_cross};
 use glam::DVec3;
 use rayon::prelude::*;
 use roar_mesh::spatial::{Aabb, TriangleBvh};
+use roar_mesh::spatial::{PreparedFace, certainly_apart, faces_intersect_filtered as faces_cross};
 
 /// Options of [`limit_steps`].
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -56,7 +56,7 @@ pub struct LimiterStats {
 ///
 /// Cost: one BVH build over the swept boxes, then per pass, for the changed faces, a walk over
 /// their candidates and the exact tests (most pairs are settled by `certainly_apart`, the rest
-/// by `crate::intersect::faces_intersect_filtered`), spread over rayon's threads. Invalid
+/// by `roar_mesh::spatial::faces_intersect_filtered`), spread over rayon's threads. Invalid
 /// indices are ignored, and so are faces with a non-finite old corner; non-finite proposals are
 /// cancelled.
 pub fn limit_steps(

@@ -29,7 +29,9 @@ mod separate;
 
 pub use limiter::{LimiterOptions, LimiterStats, limit_steps};
 
-use collapse::{Buffers, quality, try_collapse_face};
+use crate::geometry::is_degenerate;
+use collapse::{Buffers, try_collapse_face};
+use roar_mesh::spatial::triangle_quality;
 use roar_mesh::spatial::{Aabb, TriangleBvh};
 use roar_mesh::{FaceId, Mesh};
 use std::collections::BTreeSet;
@@ -47,8 +49,9 @@ pub struct UntangleOptions {
     pub step_fraction: f64,
     /// At most this many vertices move per round through region growing (default 100 000).
     pub max_region: usize,
-    /// A crossing face whose quality `4√3·area / Σ edge²` is below this is offered an edge
-    /// collapse at once (default 0.1; 0 disables).
+    /// A crossing face whose aspect ratio (`roar_mesh::spatial::triangle_quality`) is at or
+    /// above this is offered an edge collapse at once (default 10, the finish's sliver limit;
+    /// `f64::INFINITY` disables).
     pub sliver_quality: f64,
     /// A face still crossing after this many consecutive rounds is offered an edge collapse
     /// (default 8).
@@ -66,7 +69,7 @@ impl Default for UntangleOptions {
             margin_rel: 1e-6,
             step_fraction: 0.25,
             max_region: 100_000,
-            sliver_quality: 0.1,
+            sliver_quality: 10.0,
             stuck_rounds: 8,
             allow_collapses: true,
             max_collapses_per_round: 64,
@@ -200,7 +203,7 @@ fn write_positions(mesh: &mut Mesh, buffers: &Buffers) {
 }
 
 /// Crossing faces worth a collapse: slivers, and faces stuck for `stuck_rounds` rounds; worst
-/// quality first (ties by id), so the order is deterministic.
+/// aspect ratio first (ties by id), so the order is deterministic.
 fn collapse_candidates(
     buffers: &Buffers,
     crossing: &BTreeSet<FaceId>,
@@ -211,12 +214,12 @@ fn collapse_candidates(
         .iter()
         .filter_map(|&f| {
             let t = buffers.triangles[buffers.index_of[f.index()] as usize];
-            let q = quality(t.map(|i| buffers.positions[i as usize]));
+            let q = triangle_quality(t.map(|i| buffers.positions[i as usize]));
             let stuck = crossing_rounds[f.index()] >= options.stuck_rounds.max(1);
-            (q < options.sliver_quality || stuck).then_some((q, f))
+            (is_degenerate(q, options.sliver_quality) || stuck).then_some((q, f))
         })
         .collect();
-    out.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+    out.sort_by(|a, b| b.0.total_cmp(&a.0).then(a.1.cmp(&b.1)));
     out.into_iter().map(|(_, f)| f).collect()
 }
 

@@ -1,7 +1,7 @@
 //! Incremental self-intersection detection across the rounds of [`super::untangle`].
 
-use crate::intersect::faces_intersect_filtered as faces_cross;
 use glam::DVec3;
+use roar_mesh::spatial::faces_intersect_filtered as faces_cross;
 use roar_mesh::spatial::{Aabb, TriangleBvh, intersecting_pairs};
 
 /// Keeps the intersecting pairs of the previous round and re-tests only faces with a moved

@@ -4,21 +4,8 @@
 
 use super::UntangleOptions;
 use glam::DVec3;
-use roar_mesh::spatial::WindingNumber;
+use roar_mesh::spatial::{WindingNumber, area_weighted_vertex_normals};
 use std::collections::{BTreeSet, VecDeque};
-
-/// Area-weighted normals of every vertex slot, from the triangles.
-pub(super) fn vertex_normals(positions: &[DVec3], triangles: &[[u32; 3]]) -> Vec<DVec3> {
-    let mut n = vec![DVec3::ZERO; positions.len()];
-    for t in triangles {
-        let [a, b, c] = t.map(|i| positions[i as usize]);
-        let cross = (b - a).cross(c - a);
-        for i in t {
-            n[*i as usize] += cross;
-        }
-    }
-    n.iter().map(|x| x.normalize_or_zero()).collect()
-}
 
 /// Mean and shortest length of the edges at vertex `v` (zeros for an isolated slot).
 fn edge_lengths(positions: &[DVec3], adjacency: &[Vec<u32>], v: usize) -> (f64, f64) {
@@ -78,7 +65,7 @@ pub(super) fn resolve_round(
     pairs: &[(u32, u32)],
     options: &UntangleOptions,
 ) -> usize {
-    let normals = vertex_normals(positions, triangles);
+    let normals = area_weighted_vertex_normals(positions, triangles);
     let before = positions.to_vec();
     // Triangles always index live slots, so the build cannot fail; without a hierarchy no
     // vertex is classified bad and the pairs are only smoothed.

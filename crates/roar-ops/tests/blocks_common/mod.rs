@@ -93,7 +93,7 @@ pub fn assert_contract(mesh: &Mesh, opt: &Optimizer, euler: i64, what: &str) {
 pub fn worst_quality(mesh: &Mesh) -> f64 {
     mesh.faces()
         .map(|f| {
-            roar_ops::geometry::triangle_quality(mesh.face_vertices(f).map(|v| mesh.position(v)))
+            roar_mesh::spatial::triangle_quality(mesh.face_vertices(f).map(|v| mesh.position(v)))
         })
         .fold(1.0, f64::max)
 }

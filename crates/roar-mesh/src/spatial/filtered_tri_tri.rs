@@ -1,10 +1,11 @@
 //! A filtered front end to the exact [`faces_intersect`]: cheap floating-point plane-side tests
 //! that are certain (Shewchuk's static error bound for `orient3d`) settle the common "clearly
-//! apart" cases without allocation; everything else goes to the exact test. Shared by the QEM
-//! intersection veto, the untangle block and the step limiter, which test many face pairs.
+//! apart" cases without allocation; everything else goes to the exact test. Shared by everything
+//! that tests many face pairs: the self-intersection count, the QEM intersection veto, the
+//! untangle block and the step limiter.
 
+use super::tri_tri::faces_intersect;
 use glam::DVec3;
-use roar_mesh::spatial::faces_intersect;
 
 /// Shewchuk's `o3derrboundA = (7 + 56ε)ε` with `ε = 2⁻⁵³`.
 const O3D_ERR_BOUND: f64 = (7.0 + 56.0 * f64::EPSILON / 2.0) * (f64::EPSILON / 2.0);
@@ -173,7 +174,7 @@ fn certain_crossing(a: [DVec3; 3], b: [DVec3; 3]) -> Option<bool> {
 /// coplanar with it; and, for (near-)coplanar faces, a separating edge line in a coordinate
 /// projection (see `separated_in_projection`). Flat regions make the exact predicates take
 /// their slow, exact-arithmetic path, which these filters mostly avoid.
-pub(crate) fn faces_intersect_filtered(positions: &[DVec3], ta: [u32; 3], tb: [u32; 3]) -> bool {
+pub fn faces_intersect_filtered(positions: &[DVec3], ta: [u32; 3], tb: [u32; 3]) -> bool {
     let n = positions.len();
     if ta.iter().chain(&tb).any(|&i| i as usize >= n) {
         return faces_intersect(positions, ta, tb);
@@ -233,7 +234,7 @@ pub(crate) fn faces_intersect_filtered(positions: &[DVec3], ta: [u32; 3], tb: [u
 /// minors and the minors' halves of the permanent depend on the face alone and are computed
 /// once.
 #[derive(Debug, Clone, Copy)]
-pub(crate) struct PreparedFace {
+pub struct PreparedFace {
     /// Corner ids (as given to [`faces_intersect`]).
     pub ids: [u32; 3],
     /// Corner positions.
@@ -247,7 +248,7 @@ pub(crate) struct PreparedFace {
 
 impl PreparedFace {
     /// Prepares the face with corner ids `ids` at `corners`.
-    pub(crate) fn new(ids: [u32; 3], corners: [DVec3; 3]) -> PreparedFace {
+    pub fn new(ids: [u32; 3], corners: [DVec3; 3]) -> PreparedFace {
         let bd = corners[1] - corners[0];
         let cd = corners[2] - corners[0];
         let (yz, zy) = (bd.y * cd.z, bd.z * cd.y);
@@ -326,7 +327,7 @@ impl PreparedFace {
 /// the other has with it, and `b` shares all three exactly when it is `a` (so `false`); the
 /// mask of `a`'s shared corners is computed only when the first way fails.
 #[inline]
-pub(crate) fn certainly_apart(a: &PreparedFace, b: &PreparedFace) -> bool {
+pub fn certainly_apart(a: &PreparedFace, b: &PreparedFace) -> bool {
     if !(a.has_distinct_ids() & b.has_distinct_ids()) {
         return false;
     }
@@ -354,7 +355,7 @@ pub(crate) fn certainly_apart(a: &PreparedFace, b: &PreparedFace) -> bool {
 /// 3. So the sectors tile the plane around the apex: two faces' projections meet only in the
 ///    apex, or along the common edge of neighbours. A common point of the faces projects there
 ///    and, the projection being one-to-one on each face, is the apex or on the common edge.
-pub(crate) fn fan_is_embedded(apex: DVec3, rim: &[[DVec3; 2]]) -> bool {
+pub fn fan_is_embedded(apex: DVec3, rim: &[[DVec3; 2]]) -> bool {
     let normal: DVec3 = rim.iter().map(|[x, y]| (*x - apex).cross(*y - apex)).sum();
     let q = apex + normal;
     let Some(&[x0, y0]) = rim.first() else {
@@ -462,7 +463,7 @@ mod tests {
                     [point(1.0), point(1.0), point(1.0)],
                 )
             };
-            let exact = roar_mesh::spatial::triangles_intersect(a, b);
+            let exact = crate::spatial::triangles_intersect(a, b);
             if let Some(answer) = certain_crossing(a, b) {
                 assert_eq!(answer, exact, "{a:?} {b:?}");
                 decided += 1;
