@@ -72,6 +72,7 @@ impl Shape for AnalyticTorus {
             mesh,
             raw_faces,
             voxels_filled_by_winding: 0,
+            enclosures_left_open: 0,
         })
     }
 

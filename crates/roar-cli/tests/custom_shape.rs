@@ -108,6 +108,7 @@ impl Shape for AnalyticSphere {
             mesh,
             raw_faces,
             voxels_filled_by_winding: 0,
+            enclosures_left_open: 0,
         })
     }
 

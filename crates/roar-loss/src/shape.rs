@@ -48,6 +48,9 @@ pub struct InitialMesh {
     /// Voxels of a soup's watertight init that the enclosure rule (generalized winding number)
     /// made solid; 0 for other kinds of init. For reports.
     pub voxels_filled_by_winding: usize,
+    /// Regions the enclosure rule left open, their cap being too wide for a puncture (an open
+    /// surface's opening); 0 for other kinds of init. For reports.
+    pub enclosures_left_open: usize,
 }
 
 /// Figures about a shape's own preparation, for reports (zeros where a kind has no such thing).

@@ -137,14 +137,16 @@ pub struct InitConfig {
     pub init_resolution: usize,
     /// The init is decimated to at most this many faces (§4.1: 20k).
     pub init_max_faces: usize,
-    /// Enclosure rule of the watertight init (`roar_ops::init::winding_solid`; 0 = off, the
-    /// default): exterior voxels whose generalized winding number with respect to T′ is above
-    /// this value turn solid, so punctures of a closed surface close while tunnels stay (the
-    /// measured value is `roar_ops::init::ENCLOSURE_WINDING_THRESHOLD` = 0.7). Off by default
-    /// because it also fills open surfaces with a wide opening: at init + QEM to 1000 faces it
-    /// took gpytoolbox-airplane's Chamfer/diag from 2.06e-3 to 1.26e-3 but libigl-camelhead's
-    /// from 2.36e-3 to 3.74e-3 (`docs/evaluation.md`, "Punctured inputs").
+    /// Enclosure rule of the watertight init (`roar_ops::init::winding_solid`; 0 = off):
+    /// exterior voxels whose generalized winding number with respect to T′ is above this value
+    /// turn solid, so punctures of a closed surface close while tunnels stay. Default
+    /// `roar_ops::init::ENCLOSURE_WINDING_THRESHOLD` (0.7).
     pub enclosure_winding_threshold: f64,
+    /// A region the enclosure rule fills stays filled only if its widest cap (a patch of its
+    /// boundary no input surface covers) is at most this fraction of its boundary: punctures
+    /// close, the wide opening of an open surface stays open. Default
+    /// `roar_ops::init::ENCLOSURE_MAX_CAP_FRACTION` (0.02); 1 closes every opening.
+    pub enclosure_max_cap_fraction: f64,
     /// Subdivision level of the sphere init. Default 4 (§4.2 has 2; more helps a sphere reach
     /// detail).
     pub sphere_level: u32,
@@ -158,7 +160,8 @@ impl Default for InitConfig {
             kind: InitKind::Watertight,
             init_resolution: 192,
             init_max_faces: 20_000,
-            enclosure_winding_threshold: 0.0,
+            enclosure_winding_threshold: roar_ops::init::ENCLOSURE_WINDING_THRESHOLD,
+            enclosure_max_cap_fraction: roar_ops::init::ENCLOSURE_MAX_CAP_FRACTION,
             sphere_level: 4,
             sdf_init_resolution: 64,
         }
@@ -385,13 +388,15 @@ impl ReconstructConfig {
         config
     }
 
-    /// The defaults for a set of range scans: the soup's, with the init's enclosure rule on at
-    /// [`crate::pipeline::scans::SCAN_ENCLOSURE_WINDING_THRESHOLD`], since a scanned object is
-    /// closed but the scanner never sees all of it (the bunny's base).
+    /// The defaults for a set of range scans: the soup's, with the init's enclosure rule at
+    /// [`crate::pipeline::scans::SCAN_ENCLOSURE_WINDING_THRESHOLD`] closing every opening,
+    /// however wide, since a scanned object is closed but the scanner never sees all of it (the
+    /// bunny's base).
     pub fn scan_defaults() -> Self {
         let mut config = Self::default();
         config.init.enclosure_winding_threshold =
             crate::pipeline::scans::SCAN_ENCLOSURE_WINDING_THRESHOLD;
+        config.init.enclosure_max_cap_fraction = 1.0;
         config
     }
 
@@ -471,6 +476,10 @@ impl ReconstructConfig {
             (
                 off("init.enclosure_winding_threshold", 0.5, 1.0),
                 self.init.enclosure_winding_threshold,
+            ),
+            (
+                r("init.enclosure_max_cap_fraction", 0.0, 1.0),
+                self.init.enclosure_max_cap_fraction,
             ),
             (
                 r("init.sphere_level", 0.0, 8.0),
@@ -805,7 +814,8 @@ mod tests {
         assert_eq!(c.init.kind, InitKind::Watertight);
         assert_eq!(c.init.init_resolution, 192);
         assert_eq!(c.init.init_max_faces, 20_000);
-        assert_eq!(c.init.enclosure_winding_threshold, 0.0, "off by default");
+        assert_eq!(c.init.enclosure_winding_threshold, 0.7);
+        assert_eq!(c.init.enclosure_max_cap_fraction, 0.02);
         assert_eq!(roar_ops::init::ENCLOSURE_WINDING_THRESHOLD, 0.7);
         assert_eq!(c.init.sphere_level, 4);
         assert_eq!(

@@ -56,6 +56,7 @@ fn initial_mesh(
             let initial = shape.initial_mesh()?;
             stats.init.init_voxel_faces = initial.raw_faces;
             stats.init.init_voxels_filled_by_winding = initial.voxels_filled_by_winding;
+            stats.init.init_enclosures_left_open = initial.enclosures_left_open;
             initial.mesh
         }
         InitKind::Sphere => {

@@ -170,6 +170,9 @@ pub struct InitStats {
     /// Voxels the init's winding-number rule turned solid (punctures closed;
     /// `roar_ops::init::InitOptions::enclosure_winding_threshold`).
     pub init_voxels_filled_by_winding: usize,
+    /// Regions the winding-number rule left open, their cap too wide for a puncture
+    /// (`roar_ops::init::InitOptions::enclosure_max_cap_fraction`).
+    pub init_enclosures_left_open: usize,
 }
 
 /// The loop at the working budget (the `[optimize]` stage).

@@ -228,6 +228,7 @@ impl Shape for SdfShape {
             mesh,
             raw_faces,
             voxels_filled_by_winding: 0,
+            enclosures_left_open: 0,
         })
     }
 

@@ -99,6 +99,7 @@ impl Shape for SoupShape<'_> {
                 resolution: self.config.init.init_resolution,
                 enclosure_winding_threshold: (self.config.init.enclosure_winding_threshold > 0.0)
                     .then_some(self.config.init.enclosure_winding_threshold),
+                enclosure_max_cap_fraction: self.config.init.enclosure_max_cap_fraction,
                 ..InitOptions::default()
             },
             max_faces: self.config.init.init_max_faces,
@@ -111,6 +112,7 @@ impl Shape for SoupShape<'_> {
             mesh,
             raw_faces: stats.init_faces,
             voxels_filled_by_winding: stats.init.voxels_filled_by_winding,
+            enclosures_left_open: stats.init.enclosures_left_open,
         })
     }
 

@@ -326,7 +326,7 @@ fn fill_and_reflood(grid: &Grid, state: &mut Vec<u8>, fill: &[usize]) -> Vec<usi
 }
 
 /// The six face neighbours of voxel `idx` that lie in the grid.
-fn face_neighbours(grid: &Grid, idx: usize) -> [Option<usize>; 6] {
+pub(crate) fn face_neighbours(grid: &Grid, idx: usize) -> [Option<usize>; 6] {
     let c = grid.coords(idx);
     let stride = [1, grid.dims[0], grid.dims[0] * grid.dims[1]];
     let mut out = [None; 6];
