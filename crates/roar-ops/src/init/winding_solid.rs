@@ -25,10 +25,11 @@
 //! connected patch of its boundary towards the exterior, i.e. not against the input's shell) is
 //! at most `max_cap_fraction` of its whole boundary: a puncture's cap is small, an opening's is
 //! wide. Measured on the 14 wild meshes of `docs/evaluation.md` and the two punctured inputs of
-//! its "Punctured inputs": the widest cap is 0.4 % of the region's boundary on gpytoolbox-airplane (gaps in its skin), 0.5 % on clean/bunny.obj (its
-//! open base) and 0.01 % on a rocker arm with 5 % of its faces deleted, against 7 % on
-//! libigl-camelhead's neck and 21–56 % on the other regions the rule would fill (concave
-//! parts of open sheets); the default 2 % lies between.
+//! its "Punctured inputs": the widest cap is 0.4 % of the region's boundary on
+//! gpytoolbox-airplane (gaps in its skin), 0.5 % on clean/bunny.obj (its open base) and 0.01 %
+//! on a rocker arm with 5 % of its faces deleted, against 7 % on libigl-camelhead's neck and
+//! 21–56 % on the other regions the rule would fill (concave parts of open sheets); the default
+//! 2 % lies between.
 //!
 //! **Where the rule fails.** (a) Inconsistently oriented soups: faces whose normals point
 //! inward cancel the outward ones, `w` inside drops below the threshold and the punctures of
