@@ -151,3 +151,31 @@ fn reconstruction_beats_init_plus_qem_and_keeps_every_promise() {
         );
     }
 }
+
+/// trimesh-soup.stl (random triangles: the init has genus 89) at 1000 faces: the finish must
+/// remove handles to reach the budget, and no cut may leave a crossing in the output.
+#[test]
+#[ignore = "minutes in release; run by .ci/run"]
+fn a_soup_of_random_triangles_meets_the_budget_by_removing_handles_without_crossings() {
+    let Some(root) = std::env::var_os("ROAR_TEST_DATA") else {
+        assert!(
+            std::env::var("CI").as_deref() != Ok("true"),
+            "ROAR_TEST_DATA must be set under CI"
+        );
+        return;
+    };
+    let soup = roar_io::read_mesh(&PathBuf::from(root).join("wild/trimesh-soup.stl")).unwrap();
+    let config = ReconstructConfig {
+        faces: FACES,
+        ..ReconstructConfig::default()
+    };
+    let out = Reconstruction::new(config)
+        .run_soup(&soup.positions, &soup.triangles, &mut |_| {})
+        .unwrap_or_else(|e| panic!("trimesh-soup: {e}"));
+    assert!(!out.stats.finish.handles_removed.is_empty());
+    assert_eq!(out.triangles.len(), FACES);
+    let mesh = Mesh::from_triangles(out.positions.clone(), &out.triangles).unwrap();
+    mesh.validate().unwrap();
+    let crossing = self_intersecting_faces(&out.positions, &out.triangles);
+    assert_eq!(crossing.iter().filter(|&&x| x).count(), 0);
+}

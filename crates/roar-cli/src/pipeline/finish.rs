@@ -199,6 +199,9 @@ fn final_decimation(
                 handle.loop_vertices, handle.loop_length
             );
         }
+        if !removed.is_empty() {
+            untangle_cut_caps(mesh, faces, config)?;
+        }
         stats.finish.handles_removed.extend(removed);
         decimated
     };
@@ -210,6 +213,29 @@ fn final_decimation(
         )));
     }
     Ok(decimated)
+}
+
+/// Clears the crossings the caps of removed handles may make with the surface near them (a cap
+/// spans its loop's rim, whatever lies across it), then fills back to `faces`; fails with the
+/// count of faces still crossing, so no output with a self-intersection is written. A mesh
+/// without crossings is left as it is.
+fn untangle_cut_caps(
+    mesh: &mut Mesh,
+    faces: usize,
+    config: &ReconstructConfig,
+) -> Result<(), PipelineError> {
+    let untangled = untangle(
+        mesh,
+        &UntangleOptions {
+            margin_rel: config.finish.untangle_margin,
+            ..UntangleOptions::default()
+        },
+    );
+    fill_to_budget(mesh, faces);
+    match untangled.unresolved_faces.len() {
+        0 => Ok(()),
+        n => Err(PipelineError::Intersections(n)),
+    }
 }
 
 /// `config.final_smoothing_sweeps` sweeps of tangential smoothing with every move limited so

@@ -11,7 +11,9 @@
 //! `C`), hence non-contractible. The shortest of these loops over all roots is cut (with `C`
 //! built longest first they are the greedy shortest loops through the root, Erickson and
 //! Whittlesey 2005), so the
-//! handle removed is a thin one: cutting it changes the least surface.
+//! handle removed is a thin one: cutting it changes the least surface. A cut whose moved rims
+//! or caps would cross the surface nearby gives way to the next shortest loop that crosses
+//! nothing (the shortest is cut when every loop crosses; the pipeline untangles after it).
 //!
 //! **Cut and cap.** Every loop vertex is split in two: the faces on the loop's left keep one
 //! copy, those on its right the other; each copy moves a fifth of the loop's mean edge length
@@ -20,6 +22,7 @@
 
 use crate::decimate::{DecimateError, DecimateOptions, DecimateStats, minimum_faces};
 use glam::DVec3;
+use roar_mesh::spatial::count_intersecting_faces;
 use roar_mesh::{HalfedgeId, Mesh, VertexId};
 use std::cmp::Reverse;
 use std::collections::BinaryHeap;
@@ -182,28 +185,43 @@ fn remove_one_handle(
             members[*c as usize].push(v as u32);
         }
     }
-    let mut best: Option<(f64, Vec<u32>)> = None;
+    let mut loops: Vec<(f64, Vec<u32>)> = Vec::new();
     for vertices in members.iter().filter(|m| !m.is_empty()) {
         let roots = options.roots.clamp(1, vertices.len());
         for r in 0..roots {
             let root = vertices[r * vertices.len() / roots];
-            if let Some((length, cycle)) = shortest_generator_loop(&compact, root)
-                && best.as_ref().is_none_or(|(l, _)| length < *l)
-            {
-                best = Some((length, cycle));
+            loops.extend(shortest_generator_loop(&compact, root));
+        }
+    }
+    if loops.is_empty() {
+        return Err(HandleRemovalError::NoHandle);
+    }
+    // Shortest first (ties by vertex list, so the order is deterministic); the first cut whose
+    // caps and moved rims cross nothing is taken, else the shortest.
+    loops.sort_by(|a, b| a.0.total_cmp(&b.0).then_with(|| a.1.cmp(&b.1)));
+    loops.dedup_by(|a, b| a.1 == b.1);
+    let crossing_before = count_intersecting_faces(mesh);
+    let mut cuts = loops.iter().map(|(length, cycle)| {
+        let (new_positions, new_triangles) = cut_and_cap(&compact, &positions, &triangles, cycle);
+        let out = Mesh::from_triangles(new_positions, &new_triangles)
+            .map_err(|e| HandleRemovalError::Internal(format!("the cut mesh is not closed: {e}")));
+        (out, *length, cycle.len())
+    });
+    let (first, length, loop_vertices) = cuts.next().expect("at least one loop");
+    let mut chosen = (first?, length, loop_vertices);
+    if count_intersecting_faces(&chosen.0) > crossing_before {
+        for (out, length, loop_vertices) in cuts {
+            let out = out?;
+            if count_intersecting_faces(&out) <= crossing_before {
+                chosen = (out, length, loop_vertices);
+                break;
             }
         }
     }
-    let Some((length, cycle)) = best else {
-        return Err(HandleRemovalError::NoHandle);
-    };
-    let (new_positions, new_triangles) = cut_and_cap(&compact, &positions, &triangles, &cycle);
-    let out = Mesh::from_triangles(new_positions, &new_triangles)
-        .map_err(|e| HandleRemovalError::Internal(format!("the cut mesh is not closed: {e}")))?;
+    let (out, length, loop_vertices) = chosen;
     if out.genus() + 1 != mesh.genus() || out.components().0 != mesh.components().0 {
         return Err(HandleRemovalError::Internal(format!(
-            "cutting a loop of {} vertices gave genus {} (from {})",
-            cycle.len(),
+            "cutting a loop of {loop_vertices} vertices gave genus {} (from {})",
             out.genus(),
             mesh.genus()
         )));
@@ -211,7 +229,7 @@ fn remove_one_handle(
     Ok((
         out,
         RemovedHandle {
-            loop_vertices: cycle.len(),
+            loop_vertices,
             loop_length: length,
         },
     ))
