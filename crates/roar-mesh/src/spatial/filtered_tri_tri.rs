@@ -25,7 +25,12 @@ fn certain_orient3d(a: DVec3, b: DVec3, c: DVec3, d: DVec3) -> Option<i8> {
     let permanent = (bdxcdy.abs() + cdxbdy.abs()) * ad.z.abs()
         + (cdxady.abs() + adxcdy.abs()) * bd.z.abs()
         + (adxbdy.abs() + bdxady.abs()) * cd.z.abs();
-    let bound = O3D_ERR_BOUND * permanent;
+    certain_sign(det, O3D_ERR_BOUND * permanent)
+}
+
+/// The sign of `det` when its magnitude exceeds the error `bound`, else `None`.
+#[inline]
+fn certain_sign(det: f64, bound: f64) -> Option<i8> {
     if det > bound {
         Some(1)
     } else if -det > bound {
@@ -44,15 +49,7 @@ const O2D_ERR_BOUND: f64 = (3.0 + 16.0 * f64::EPSILON / 2.0) * (f64::EPSILON / 2
 fn certain_orient2d(i: usize, j: usize, a: DVec3, b: DVec3, c: DVec3) -> Option<i8> {
     let left = (a[i] - c[i]) * (b[j] - c[j]);
     let right = (a[j] - c[j]) * (b[i] - c[i]);
-    let det = left - right;
-    let bound = O2D_ERR_BOUND * (left.abs() + right.abs());
-    if det > bound {
-        Some(1)
-    } else if -det > bound {
-        Some(-1)
-    } else {
-        None
-    }
+    certain_sign(left - right, O2D_ERR_BOUND * (left.abs() + right.abs()))
 }
 
 /// The two coordinate axes kept when dropping the largest component of `n`.
