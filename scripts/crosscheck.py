@@ -95,10 +95,12 @@ def aspect_ratio_median(v, f):
     la = np.linalg.norm(b - c, axis=1)
     lb = np.linalg.norm(c - a, axis=1)
     lc = np.linalg.norm(a - b, axis=1)
-    s = 0.5 * (la + lb + lc)
-    den = 8.0 * (s - la) * (s - lb) * (s - lc)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        q = la * lb * lc / den
+    # R/(2r) = abc·s / (8K²), the area K from the cross product (Heron's (s−a)(s−b)(s−c)
+    # cancels on flat triangles, which would then drop out of the median).
+    twice_area = np.linalg.norm(np.cross(b - a, c - a), axis=1)
+    den = 4.0 * twice_area * twice_area
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+        q = la * lb * lc * (la + lb + lc) / den
     q = q[(den > 0) & np.isfinite(q)]
     return float(np.median(q)) if len(q) else None
 
