@@ -133,16 +133,18 @@ fn finish_from_best_state(
 /// any geometry, so no intersection comes back). Returns how many faces it could not clear.
 fn fill_and_untangle(mesh: &mut Mesh, config: &ReconstructConfig, stats: &mut RunStats) -> usize {
     stats.finish.fill_splits = fill_to_budget(mesh, config.faces);
-    let untangled = untangle(
-        mesh,
-        &UntangleOptions {
-            margin_rel: config.finish.untangle_margin,
-            ..UntangleOptions::default()
-        },
-    );
+    let untangled = untangle(mesh, &untangle_options(config));
     record_untangle(stats, &untangled);
     stats.finish.fill_splits += fill_to_budget(mesh, config.faces);
     untangled.unresolved_faces.len()
+}
+
+/// The untangle block's options under `config` (its separation margin).
+fn untangle_options(config: &ReconstructConfig) -> UntangleOptions {
+    UntangleOptions {
+        margin_rel: config.finish.untangle_margin,
+        ..UntangleOptions::default()
+    }
 }
 
 fn record_untangle(stats: &mut RunStats, untangled: &UntangleStats) {
@@ -224,13 +226,7 @@ fn untangle_cut_caps(
     faces: usize,
     config: &ReconstructConfig,
 ) -> Result<(), PipelineError> {
-    let untangled = untangle(
-        mesh,
-        &UntangleOptions {
-            margin_rel: config.finish.untangle_margin,
-            ..UntangleOptions::default()
-        },
-    );
+    let untangled = untangle(mesh, &untangle_options(config));
     fill_to_budget(mesh, faces);
     match untangled.unresolved_faces.len() {
         0 => Ok(()),
