@@ -7,7 +7,7 @@
 #   scripts/budget-check.sh [--budgets "500 1000 5000"] [--meshes "GLOB ..."] [--out DIR]
 #
 # Inputs: $ROAR_TEST_DATA/{clean,wild} (default ROAR_TEST_DATA: ../shared/data/meshes beside the
-# repo). Uses target/release/roar (built first). Exit status 1 when any run breaks a promise.
+# repo). Uses the release roar under $CARGO_TARGET_DIR (default target/), built first. Exit status 1 when any run breaks a promise.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -26,6 +26,7 @@ done
 data="${ROAR_TEST_DATA:-../shared/data/meshes}"
 [ -d "$data/clean" ] || { echo "budget-check.sh: no $data/clean (set ROAR_TEST_DATA)" >&2; exit 2; }
 cargo build --release -p roar-cli --quiet
+roar="${CARGO_TARGET_DIR:-target}/release/roar"
 mkdir -p "$out"
 table="$out/budget-check.tsv"
 printf 'mesh\tfaces\tstatus\toutput faces\twatertight\tself-intersecting faces\tinit genus\toutput genus\thandles removed\tseconds\n' > "$table"
@@ -38,7 +39,7 @@ for pattern in $meshes; do
       result="$out/${name%.*}-$n.obj"
       report="$out/${name%.*}-$n.json"
       start=$(date +%s.%N)
-      if target/release/roar reconstruct "$input" -o "$result" --faces "$n" --report "$report" \
+      if "$roar" reconstruct "$input" -o "$result" --faces "$n" --report "$report" \
           --quiet 2> "$out/${name%.*}-$n.log"; then
         seconds=$(echo "$(date +%s.%N) - $start" | bc)
         line=$(python3 - "$report" "$n" "$seconds" <<'PY'
