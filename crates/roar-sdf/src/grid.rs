@@ -25,12 +25,25 @@ use crate::SdfError;
 /// Points interpolated per parallel task.
 const CHUNK: usize = 4096;
 
-/// The sidecar's contents.
+/// Bounds as a sidecar writes them: `{"min": [x, y, z], "max": [x, y, z]}` (a grid's whole
+/// sidecar; the `bounds` of a network's).
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
-struct Sidecar {
+pub(crate) struct BoundsSpec {
     min: [f64; 3],
     max: [f64; 3],
+}
+
+impl BoundsSpec {
+    /// The box, or why it is none.
+    pub(crate) fn to_aabb(&self) -> Result<Aabb, SdfError> {
+        let bounds = Aabb {
+            min: DVec3::from_array(self.min),
+            max: DVec3::from_array(self.max),
+        };
+        check_bounds(&bounds)?;
+        Ok(bounds)
+    }
 }
 
 /// Samples of a signed distance on a regular grid over `bounds` ([module docs](self)).
@@ -219,17 +232,15 @@ pub fn read_sidecar(path: &Path) -> Result<Option<Aabb>, SdfError> {
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(None),
         Err(e) => return Err(SdfError::Io(format!("{}: {e}", sidecar.display()))),
     };
-    let spec: Sidecar = serde_json::from_str(&text).map_err(|e| {
+    let spec: BoundsSpec = serde_json::from_str(&text).map_err(|e| {
         SdfError::Grid(format!(
             "{}: {e} (expected {{\"min\": [x, y, z], \"max\": [x, y, z]}})",
             sidecar.display()
         ))
     })?;
-    let bounds = Aabb {
-        min: DVec3::from_array(spec.min),
-        max: DVec3::from_array(spec.max),
-    };
-    check_bounds(&bounds).map_err(|e| SdfError::Grid(format!("{}: {e}", sidecar.display())))?;
+    let bounds = spec
+        .to_aabb()
+        .map_err(|e| SdfError::Grid(format!("{}: {e}", sidecar.display())))?;
     Ok(Some(bounds))
 }
 

@@ -1,7 +1,8 @@
 //! # roar-sdf
 //!
 //! Signed distance functions as inputs of roar (spec §5): readers for the kinds of field
-//! (an analytic `.sdf.toml` [`AnalyticSdf`], a neural MLP `.npz` [`Mlp`], a dense `.npy` grid
+//! (an analytic `.sdf.toml` [`AnalyticSdf`], a neural MLP [`Mlp`] from a sequential `.npz` or an
+//! IDR/VolSDF/NeuS `.safetensors` state dict ([`implicit_network`]), a dense `.npy` grid
 //! [`GridSdf`]), all behind
 //! `roar_mesh::spatial::Sdf`, and what the pipeline needs from a field: its normal maps by
 //! grid-bracketed tracing ([`trace`]), the Face Split projector and the projection of samples
@@ -11,6 +12,7 @@
 pub mod analytic;
 pub mod extract;
 pub mod grid;
+pub mod implicit_network;
 pub mod network;
 pub mod project;
 pub mod trace;
@@ -44,7 +46,7 @@ pub enum SdfError {
     #[error("{0}")]
     Grid(String),
     /// The file's extension names no SDF kind.
-    #[error("not an SDF input (.npz, .sdf.toml or .npy)")]
+    #[error("not an SDF input (.npz, .safetensors, .sdf.toml or .npy)")]
     UnknownKind,
 }
 
@@ -63,13 +65,16 @@ pub struct SdfInput {
     pub bounds: Option<Aabb>,
 }
 
-/// True when `path` names an SDF input by its extension: `.npz`, `.sdf.toml` or `.npy`.
+/// True when `path` names an SDF input by its extension: `.npz`, `.safetensors`, `.sdf.toml` or
+/// `.npy`.
 pub fn is_sdf_path(path: &Path) -> bool {
     let name = path
         .file_name()
         .map(|n| n.to_string_lossy().to_ascii_lowercase())
         .unwrap_or_default();
-    name.ends_with(".npz") || name.ends_with(".sdf.toml") || name.ends_with(".npy")
+    [".npz", ".safetensors", ".sdf.toml", ".npy"]
+        .iter()
+        .any(|extension| name.ends_with(extension))
 }
 
 /// Reads the SDF at `path`, of the kind its extension names ([`is_sdf_path`]); a grid without
@@ -78,8 +83,8 @@ pub fn load_sdf(path: &Path) -> Result<Arc<dyn Sdf>, SdfError> {
     Ok(load_sdf_input(path, DEFAULT_BOUNDS)?.field)
 }
 
-/// Reads the SDF at `path` ([`load_sdf`]) with the bounds its file gives; a grid without a
-/// sidecar is placed over `grid_bounds`.
+/// Reads the SDF at `path` ([`load_sdf`]) with the bounds its file gives (a grid's or a
+/// network's sidecar); a grid without a sidecar is placed over `grid_bounds`.
 pub fn load_sdf_input(path: &Path, grid_bounds: Aabb) -> Result<SdfInput, SdfError> {
     let name = path
         .file_name()
@@ -89,6 +94,12 @@ pub fn load_sdf_input(path: &Path, grid_bounds: Aabb) -> Result<SdfInput, SdfErr
         Ok(SdfInput {
             field: Arc::new(Mlp::from_npz_file(path)?),
             bounds: None,
+        })
+    } else if name.ends_with(".safetensors") {
+        let (network, bounds) = implicit_network::read_implicit_network(path)?;
+        Ok(SdfInput {
+            field: Arc::new(network),
+            bounds,
         })
     } else if name.ends_with(".sdf.toml") {
         Ok(SdfInput {

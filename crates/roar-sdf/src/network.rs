@@ -1,6 +1,6 @@
-//! A neural SDF: a sequential MLP read from an `.npz` file (the format of the
-//! neural-implicit-queries sample networks), evaluated in f32 batches with its input gradient by
-//! backpropagation.
+//! A neural SDF: an MLP evaluated in f32 batches with its input gradient by backpropagation,
+//! read from a sequential `.npz` file (the format of the neural-implicit-queries sample networks,
+//! below) or from an IDR/VolSDF/NeuS state dict in `.safetensors` ([`crate::implicit_network`]).
 //!
 //! The file is a zip of `.npy` arrays whose names are `NNNN.KIND…`, applied in the order of
 //! their 4-digit prefix: `NNNN.dense.A` (in × out) with `NNNN.dense.b` (out), `y = x·A + b`; an
@@ -9,12 +9,13 @@
 //! the last gives 1.
 
 use std::collections::BTreeMap;
+use std::f32::consts::FRAC_1_SQRT_2;
 use std::fs::File;
 use std::io::{Read, Seek};
 use std::path::Path;
 
 use glam::DVec3;
-use ndarray::{Array1, Array2, ArrayD, Dimension, Ix1, Ix2};
+use ndarray::{Array1, Array2, ArrayD, Axis, Dimension, Ix1, Ix2, Slice, concatenate};
 use ndarray_npy::NpzReader;
 use rayon::prelude::*;
 use roar_mesh::spatial::{Sdf, SdfCounter, SdfEvaluations};
@@ -25,7 +26,7 @@ use crate::SdfError;
 const CHUNK: usize = 2048;
 
 /// An elementwise activation of a layer.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Activation {
     /// `max(z, 0)`.
     Relu,
@@ -35,8 +36,11 @@ pub enum Activation {
     Tanh,
     /// `sin z`.
     Sin,
-    /// `ln(1 + eᶻ)` (β = 1).
-    Softplus,
+    /// `ln(1 + e^{βz}) / β`: β = 1 in `.npz` files, 100 in IDR/VolSDF/NeuS networks.
+    Softplus {
+        /// The sharpness β.
+        beta: f32,
+    },
 }
 
 impl Activation {
@@ -46,7 +50,7 @@ impl Activation {
             "elu" => Self::Elu,
             "tanh" => Self::Tanh,
             "sin" => Self::Sin,
-            "softplus" => Self::Softplus,
+            "softplus" => Self::Softplus { beta: 1.0 },
             _ => return None,
         })
     }
@@ -63,7 +67,10 @@ impl Activation {
             }
             Self::Tanh => z.tanh(),
             Self::Sin => z.sin(),
-            Self::Softplus => z.max(0.0) + (-z.abs()).exp().ln_1p(),
+            Self::Softplus { beta } => {
+                let bz = beta * z;
+                (bz.max(0.0) + (-bz.abs()).exp().ln_1p()) / beta
+            }
         }
     }
 
@@ -79,18 +86,26 @@ impl Activation {
             }
             Self::Tanh => 1.0 - z.tanh().powi(2),
             Self::Sin => z.cos(),
-            Self::Softplus => 1.0 / (1.0 + (-z).exp()),
+            Self::Softplus { beta } => 1.0 / (1.0 + (-beta * z).exp()),
         }
     }
 }
 
 /// One step of the network.
 #[derive(Clone, Debug)]
-enum Op {
+pub(crate) enum Op {
     /// `y = x·a + b`, `a` in × out.
     Dense { a: Array2<f32>, b: Array1<f32> },
     /// Elementwise activation.
     Activation(Activation),
+    /// `y = s·x`.
+    Scale(f32),
+    /// The positional encoding `(x, sin 2⁰x, cos 2⁰x, …, sin 2ᵏ⁻¹x, cos 2ᵏ⁻¹x)` with `k`
+    /// frequencies (IDR's embedder; `k = 0` is the identity). Its output is the encoded input
+    /// that [`Op::ConcatEncoded`] appends; a network has at most one, before any of those.
+    Encode { frequencies: u32 },
+    /// `y = (x, e) / √2` with `e` the encoded input (a skip connection of IDR/NeuS).
+    ConcatEncoded,
 }
 
 /// A sequential MLP `R³ → R` ([module docs](self): the format).
@@ -210,6 +225,14 @@ impl Mlp {
         })
     }
 
+    /// A network of `ops` mapping 3 inputs to 1 output (the caller checked the widths).
+    pub(crate) fn from_ops(ops: Vec<Op>) -> Self {
+        Self {
+            ops,
+            counter: SdfCounter::default(),
+        }
+    }
+
     /// A network of dense layers `(A, b)` with `activation` between them (none after the last):
     /// for tests and benches.
     pub fn from_layers(layers: Vec<(Array2<f32>, Array1<f32>)>, activation: Activation) -> Self {
@@ -231,11 +254,24 @@ impl Mlp {
     /// gradient (n × 3) by backpropagation.
     fn forward(&self, x: Array2<f32>, with_gradient: bool) -> (Vec<f32>, Option<Array2<f32>>) {
         let mut inputs: Vec<Array2<f32>> = Vec::new();
+        let mut encoded: Option<Array2<f32>> = None;
         let mut h = x;
         for op in &self.ops {
             let next = match op {
                 Op::Dense { a, b } => h.dot(a) + b,
                 Op::Activation(act) => h.mapv(|z| act.value(z)),
+                Op::Scale(s) => h.mapv(|z| s * z),
+                Op::Encode { frequencies } => {
+                    let e = encode(&h, *frequencies);
+                    encoded = Some(e.clone());
+                    e
+                }
+                Op::ConcatEncoded => {
+                    let e = encoded.as_ref().expect("the encoding comes before a skip");
+                    concatenate(Axis(1), &[h.view(), e.view()])
+                        .expect("one row per point")
+                        .mapv(|z| z * FRAC_1_SQRT_2)
+                }
             };
             if with_gradient {
                 inputs.push(std::mem::replace(&mut h, next));
@@ -248,6 +284,8 @@ impl Mlp {
             return (values, None);
         }
         let mut g = Array2::<f32>::ones((values.len(), 1));
+        // The gradient reaching the encoded input through the skip connections.
+        let mut g_encoded: Option<Array2<f32>> = None;
         for (op, input) in self.ops.iter().zip(&inputs).rev() {
             g = match op {
                 Op::Dense { a, .. } => g.dot(&a.t()),
@@ -255,10 +293,66 @@ impl Mlp {
                     g.zip_mut_with(input, |g, &z| *g *= act.derivative(z));
                     g
                 }
+                Op::Scale(s) => g.mapv(|z| s * z),
+                Op::ConcatEncoded => {
+                    let width = input.ncols();
+                    let to_e = g
+                        .slice_axis(Axis(1), Slice::from(width..))
+                        .mapv(|z| z * FRAC_1_SQRT_2);
+                    g_encoded = Some(match g_encoded.take() {
+                        Some(sum) => sum + to_e,
+                        None => to_e,
+                    });
+                    g.slice_axis(Axis(1), Slice::from(..width))
+                        .mapv(|z| z * FRAC_1_SQRT_2)
+                }
+                Op::Encode { frequencies } => {
+                    if let Some(skips) = g_encoded.take() {
+                        g += &skips;
+                    }
+                    encode_backward(input, &g, *frequencies)
+                }
             };
         }
         (values, Some(g))
     }
+}
+
+/// The positional encoding of the rows of `x` ([`Op::Encode`]).
+fn encode(x: &Array2<f32>, frequencies: u32) -> Array2<f32> {
+    let d = x.ncols();
+    let mut e = Array2::<f32>::zeros((x.nrows(), d * (1 + 2 * frequencies as usize)));
+    e.slice_axis_mut(Axis(1), Slice::from(..d)).assign(x);
+    for k in 0..frequencies as usize {
+        let scaled = x.mapv(|z| z * (1u32 << k) as f32);
+        let at = d * (1 + 2 * k);
+        e.slice_axis_mut(Axis(1), Slice::from(at..at + d))
+            .assign(&scaled.mapv(f32::sin));
+        e.slice_axis_mut(Axis(1), Slice::from(at + d..at + 2 * d))
+            .assign(&scaled.mapv(f32::cos));
+    }
+    e
+}
+
+/// The gradient at `x` of the encoding ([`encode`]) given the gradient `g` at its output.
+fn encode_backward(x: &Array2<f32>, g: &Array2<f32>, frequencies: u32) -> Array2<f32> {
+    let d = x.ncols();
+    let mut out = g.slice_axis(Axis(1), Slice::from(..d)).to_owned();
+    for k in 0..frequencies as usize {
+        let f = (1u32 << k) as f32;
+        let at = d * (1 + 2 * k);
+        let g_sin = g.slice_axis(Axis(1), Slice::from(at..at + d));
+        let g_cos = g.slice_axis(Axis(1), Slice::from(at + d..at + 2 * d));
+        ndarray::Zip::from(&mut out)
+            .and(x)
+            .and(g_sin)
+            .and(g_cos)
+            .for_each(|o, &z, &gs, &gc| {
+                let (sin, cos) = (f * z).sin_cos();
+                *o += f * (cos * gs - sin * gc);
+            });
+    }
+    out
 }
 
 fn to_rows(points: &[DVec3]) -> Array2<f32> {

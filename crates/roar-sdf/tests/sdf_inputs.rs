@@ -172,7 +172,8 @@ fn network_gradients_match_finite_differences() {
     let points: Vec<DVec3> = (0..300).map(|_| DVec3::new(r(), r(), r())).collect();
     for activation in [
         Activation::Elu,
-        Activation::Softplus,
+        Activation::Softplus { beta: 1.0 },
+        Activation::Softplus { beta: 100.0 },
         Activation::Tanh,
         Activation::Sin,
         Activation::Relu,

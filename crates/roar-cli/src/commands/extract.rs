@@ -19,7 +19,7 @@ use crate::checks::check_paths;
 /// Arguments of `roar extract`.
 #[derive(Args, Debug)]
 pub struct ExtractArgs {
-    /// A signed distance function: `.npz`, `.sdf.toml` or `.npy` (with its `.json` sidecar).
+    /// A signed distance function: `.npz`, `.safetensors`, `.sdf.toml` or `.npy` (with its `.json` sidecar).
     pub input: PathBuf,
     /// Where to write the zero set (format by extension).
     #[arg(short, long)]

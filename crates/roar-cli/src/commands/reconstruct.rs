@@ -29,8 +29,9 @@ use crate::pipeline::{
 pub struct ReconstructArgs {
     /// Any triangle soup (OBJ, PLY, STL or OFF; a PLY range image is its patch), a set of range
     /// scans (a Stanford `.conf` or the folder holding one; `docs/scans.md`), or a signed
-    /// distance function: a neural MLP (`.npz`), an analytic shape (`.sdf.toml`) or a dense grid
-    /// (`.npy`, bounds from its `.json` sidecar), negative inside (`docs/sdf.md`).
+    /// distance function: a neural MLP (`.npz`, or an IDR/NeuS `.safetensors` with its `.json`
+    /// architecture), an analytic shape (`.sdf.toml`) or a dense grid (`.npy`, bounds from its
+    /// `.json` sidecar), negative inside (`docs/sdf.md`).
     pub input: Option<PathBuf>,
     /// Where to write the result (format by extension).
     #[arg(short, long)]
@@ -299,7 +300,7 @@ fn file_name(path: &std::path::Path) -> String {
     )
 }
 
-/// Reconstructs an SDF input (`.npz`, `.sdf.toml`, `.npy`): reads the field (one-line errors, nothing
+/// Reconstructs an SDF input (`.npz`, `.safetensors`, `.sdf.toml`, `.npy`): reads the field (one-line errors, nothing
 /// written on failure), runs the pipeline on its [`SdfShape`] inside `--bounds` (or a grid's sidecar bounds), and reports the
 /// field's evaluations and how far the output's vertices are from the zero set.
 fn run_sdf(

@@ -1,5 +1,5 @@
 //! A signed distance function as a [`Shape`] (spec §5): the input kind `roar reconstruct` reads
-//! from `.npz` networks, `.sdf.toml` files and `.npy` grids (`roar_sdf`).
+//! from `.npz` and `.safetensors` networks, `.sdf.toml` files and `.npy` grids (`roar_sdf`).
 //!
 //! In rig coordinates (the bounds' centre at the origin, their corners on the rig's sphere):
 //! the target renders are traced normal maps of the zero set (`roar_sdf::trace`); the initial
