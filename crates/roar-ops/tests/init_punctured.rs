@@ -12,7 +12,7 @@ use rand_chacha::ChaCha8Rng;
 use roar_mesh::Mesh;
 use roar_mesh::shapes::{genus_n_solid, torus};
 use roar_mesh::spatial::TriangleBvh;
-use roar_ops::init::{InitOptions, WatertightInit, watertight_init};
+use roar_ops::init::{InitOptions, ScannerView, WatertightInit, watertight_init};
 use std::collections::{HashMap, HashSet};
 
 fn soup_of(mesh: &Mesh) -> Soup {
@@ -307,4 +307,68 @@ fn a_threshold_below_one_half_is_refused() {
         err.to_string().contains("enclosure_winding_threshold"),
         "{err}"
     );
+}
+
+#[test]
+fn a_cube_scanned_from_two_opposite_sides_is_solid_only_with_the_lines_of_sight() {
+    // The unit cube's top (seen from +z) and bottom (seen from −z), its sides unseen: the
+    // winding number at its centre is 2 × 1/6 (two faces' solid angles), under any threshold,
+    // so the winding rule leaves two thin shells; every point inside is hidden from both
+    // scanners by the faces they measured, so the lines of sight make the cube solid.
+    let top = sheet(16, |_, _| 1.0);
+    let mut bottom = sheet(16, |_, _| 0.0);
+    for t in &mut bottom.triangles {
+        t.swap(1, 2);
+    }
+    let base = top.positions.len() as u32;
+    let soup = Soup {
+        positions: [top.positions.clone(), bottom.positions.clone()].concat(),
+        triangles: top
+            .triangles
+            .iter()
+            .copied()
+            .chain(bottom.triangles.iter().map(|t| t.map(|v| v + base)))
+            .collect(),
+    };
+    let view = |patch: &Soup, toward_scanner: DVec3| ScannerView {
+        toward_scanner,
+        positions: patch.positions.clone(),
+        triangles: patch.triangles.clone(),
+    };
+    let options = InitOptions {
+        resolution: 48,
+        enclosure_winding_threshold: Some(0.6),
+        enclosure_max_cap_fraction: 1.0,
+        ..InitOptions::default()
+    };
+    let volume = |out: &WatertightInit| -> f64 {
+        out.triangles
+            .iter()
+            .map(|t| {
+                let [a, b, c] = t.map(|v| out.positions[v as usize]);
+                a.dot(b.cross(c)) / 6.0
+            })
+            .sum()
+    };
+    let shells = watertight_init(&soup.positions, &soup.triangles, &options).unwrap();
+    let with_sight = InitOptions {
+        scanner_views: vec![view(&top, DVec3::Z), view(&bottom, -DVec3::Z)],
+        ..options
+    };
+    let solid = watertight_init(&soup.positions, &soup.triangles, &with_sight).unwrap();
+    let (pieces, genus) = pieces_and_genus(&solid);
+    println!(
+        "winding rule alone: {:?} pieces, volume {:.3}; with the lines of sight: {pieces} \
+         piece(s), genus {genus}, volume {:.3}, {} voxels hidden",
+        genus_of(&shells).0,
+        volume(&shells),
+        volume(&solid),
+        solid.stats.voxels_hidden_from_scanners
+    );
+    assert!(
+        volume(&shells) < 0.3,
+        "the winding rule alone filled the cube"
+    );
+    assert_eq!((pieces, genus), (1, 0));
+    assert!(volume(&solid) > 0.9, "volume {}", volume(&solid));
 }

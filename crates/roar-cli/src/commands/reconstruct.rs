@@ -198,7 +198,8 @@ pub fn run(args: &ReconstructArgs) -> anyhow::Result<()> {
     check_resources(&config, soup.triangles.len(), args.force)?;
 
     let mut progress = Progress::new(args.quiet, config.optimize.iterations);
-    let mut shape = SoupShape::new(file_name(input), &soup.positions, &soup.triangles, &config);
+    let mut shape = SoupShape::new(file_name(input), &soup.positions, &soup.triangles, &config)
+        .with_scanner_views(scans.as_ref().map_or_else(Vec::new, |s| s.scanner_views()));
     let mut reconstruction = Reconstruction::new(config.clone());
     let result = reconstruction
         .run(&mut shape, &mut |p| progress.report(p))

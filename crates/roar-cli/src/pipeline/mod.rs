@@ -167,8 +167,9 @@ pub struct InitStats {
     pub init_components: usize,
     /// Genus of M0 (kept to the end unless `handles_removed` says otherwise).
     pub init_genus: usize,
-    /// Voxels the init's winding-number rule turned solid (punctures closed;
-    /// `roar_ops::init::InitOptions::enclosure_winding_threshold`).
+    /// Voxels the init's enclosure rule turned solid (punctures closed;
+    /// `roar_ops::init::InitOptions::enclosure_winding_threshold`; for scan sets also the
+    /// voxels hidden from every scanner, `roar_ops::init::InitOptions::scanner_views`).
     pub init_voxels_filled_by_winding: usize,
     /// Regions the winding-number rule left open, their cap too wide for a puncture
     /// (`roar_ops::init::InitOptions::enclosure_max_cap_fraction`).

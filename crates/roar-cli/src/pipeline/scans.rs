@@ -6,12 +6,16 @@
 //! the patches by the `.conf` poses and refines the poses by ICP (`roar_ops::align`). The union
 //! of the aligned patches, holes and overlaps included, is the target: a [`crate::pipeline::SoupShape`]
 //! of it, with the scan defaults' enclosure rule (`ReconstructConfig::scan_defaults`), since a
-//! scanned object is closed but the scanner never sees all of it (the bunny's base).
+//! scanned object is closed but the scanner never sees all of it (the bunny's base), and the
+//! scanners' lines of sight ([`AlignedScans::scanner_views`]), which close what the scanners
+//! saw only from outside.
 
 use std::path::Path;
 
+use glam::DVec3;
 use roar_io::{IoError, PatchOptions, TriangleSoup};
 use roar_ops::align::{AlignOptions, RigidTransform, ScanPatch, align_scans};
+use roar_ops::init::ScannerView;
 use serde::Serialize;
 
 use super::ReconstructConfig;
@@ -47,6 +51,9 @@ pub struct AlignedScans {
     pub patches: Vec<TriangleSoup>,
     /// One report per scan, in `.conf` order.
     pub reports: Vec<ScanReport>,
+    /// Per scan, the unit direction toward its scanner in the common frame: its frame's +z
+    /// placed by the final pose (the scanner looks along −z).
+    pub toward_scanner: Vec<DVec3>,
 }
 
 impl AlignedScans {
@@ -61,6 +68,20 @@ impl AlignedScans {
         }
         let (positions, triangles) = crate::input::drop_unreferenced(&positions, &triangles);
         TriangleSoup::new(positions, triangles)
+    }
+
+    /// Each scan's patch with the direction toward its scanner, for the init's lines of sight
+    /// (`roar_ops::init::ScannerView`).
+    pub fn scanner_views(&self) -> Vec<ScannerView> {
+        self.patches
+            .iter()
+            .zip(&self.toward_scanner)
+            .map(|(patch, &toward_scanner)| ScannerView {
+                toward_scanner,
+                positions: patch.positions.clone(),
+                triangles: patch.triangles.clone(),
+            })
+            .collect()
     }
 }
 
@@ -131,7 +152,12 @@ pub fn load_scans(
             *p = pose.apply(*p);
         }
     }
-    Ok(AlignedScans { patches, reports })
+    let toward_scanner = poses.iter().map(|pose| pose.rotation * DVec3::Z).collect();
+    Ok(AlignedScans {
+        patches,
+        reports,
+        toward_scanner,
+    })
 }
 
 /// The enclosure rule's threshold for scan sets (`enclosure_winding_threshold` of

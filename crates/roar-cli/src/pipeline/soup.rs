@@ -16,7 +16,7 @@ use roar_loss::{
 };
 use roar_mesh::Mesh;
 use roar_mesh::spatial::{Aabb, Normalization};
-use roar_ops::init::{InitOptions, InitialMeshOptions};
+use roar_ops::init::{InitOptions, InitialMeshOptions, ScannerView};
 use roar_render::{Camera, Image};
 
 use super::{ReconstructConfig, target_options};
@@ -28,6 +28,8 @@ pub struct SoupShape<'a> {
     positions: &'a [DVec3],
     triangles: &'a [[u32; 3]],
     config: ReconstructConfig,
+    /// The scanners the soup was measured from (range scans), in the soup's coordinates.
+    scanner_views: Vec<ScannerView>,
     /// T′ and its renders, made by [`Shape::prepare`].
     target: Option<Target>,
 }
@@ -46,8 +48,17 @@ impl<'a> SoupShape<'a> {
             positions,
             triangles,
             config: config.clone(),
+            scanner_views: Vec::new(),
             target: None,
         }
+    }
+
+    /// The soup as the union of range scans seen from `views` (in the soup's coordinates): the
+    /// init also turns solid what every scanner saw only through measured surface
+    /// (`roar_ops::init::InitOptions::scanner_views`).
+    pub fn with_scanner_views(mut self, views: Vec<ScannerView>) -> Self {
+        self.scanner_views = views;
+        self
     }
 
     /// The cleaned target T′, once prepared.
@@ -100,6 +111,19 @@ impl Shape for SoupShape<'_> {
                 enclosure_winding_threshold: (self.config.init.enclosure_winding_threshold > 0.0)
                     .then_some(self.config.init.enclosure_winding_threshold),
                 enclosure_max_cap_fraction: self.config.init.enclosure_max_cap_fraction,
+                scanner_views: self
+                    .scanner_views
+                    .iter()
+                    .map(|view| ScannerView {
+                        toward_scanner: view.toward_scanner,
+                        positions: view
+                            .positions
+                            .iter()
+                            .map(|&p| target.normalization.apply(p))
+                            .collect(),
+                        triangles: view.triangles.clone(),
+                    })
+                    .collect(),
                 ..InitOptions::default()
             },
             max_faces: self.config.init.init_max_faces,

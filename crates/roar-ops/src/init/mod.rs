@@ -7,7 +7,8 @@
 //! 2. close one-voxel gaps (26-neighbour dilation of the marked set), flood-fill the exterior from
 //!    the grid border (6-connectivity), turn solid the exterior voxels whose generalized winding
 //!    number is above [`InitOptions::enclosure_winding_threshold`] (so punctures of closed
-//!    surfaces close while real tunnels and open sheets stay; module `winding_solid`), then let
+//!    surfaces close while real tunnels and open sheets stay; module `winding_solid`) or, for
+//!    range scans, that every scanner sees only through measured surface (module `sight`), then let
 //!    the exterior grow back one voxel into untouched voxels (the second half of a morphological
 //!    closing, so the surface hugs the touched voxels while gaps stay closed), never through a
 //!    voxel that would join two exterior groups (so the regrowth cuts no tunnel through a thin
@@ -26,6 +27,7 @@ mod grid;
 mod initial;
 mod pieces;
 mod project;
+mod sight;
 mod simple;
 mod solid;
 mod surface;
@@ -33,6 +35,7 @@ mod voxelize;
 mod winding_solid;
 
 pub use initial::{InitialMeshOptions, InitialMeshStats, initial_mesh, initial_mesh_from_init};
+pub use sight::ScannerView;
 
 use glam::DVec3;
 use grid::{Grid, SOLID};
@@ -85,6 +88,10 @@ pub struct InitOptions {
     /// boundary, so punctures close and wide openings (a head open at the neck) stay open.
     /// Default [`ENCLOSURE_MAX_CAP_FRACTION`]; 1 accepts every region. In `[0, 1]`.
     pub enclosure_max_cap_fraction: f64,
+    /// The scanners a set of range scans was measured from, in the soup's coordinates: with the
+    /// enclosure rule on, exterior voxels hidden from every one of them by the surface it
+    /// measured turn solid too (module `sight`). Empty for soups.
+    pub scanner_views: Vec<ScannerView>,
 }
 
 impl Default for InitOptions {
@@ -105,6 +112,7 @@ impl Default for InitOptions {
             max_repair_passes: 64,
             enclosure_winding_threshold: Some(ENCLOSURE_WINDING_THRESHOLD),
             enclosure_max_cap_fraction: ENCLOSURE_MAX_CAP_FRACTION,
+            scanner_views: Vec::new(),
         }
     }
 }
@@ -160,9 +168,13 @@ pub struct InitStats {
     pub nonmanifold_vertices_resolved: usize,
     /// Voxels added to the solid by the manifold repair.
     pub voxels_added_for_manifoldness: usize,
-    /// Exterior voxels turned solid by the winding-number rule (punctures closed; 0 for the SDF
-    /// init or when the rule is off).
+    /// Exterior voxels turned solid by the enclosure rule, by their winding number or, with
+    /// [`InitOptions::scanner_views`], as hidden from every scanner (punctures closed; 0 for the
+    /// SDF init or when the rule is off).
     pub voxels_filled_by_winding: usize,
+    /// Exterior voxels hidden from every scanner of [`InitOptions::scanner_views`] (turned
+    /// solid with the winding rule's; 0 without scanner views).
+    pub voxels_hidden_from_scanners: usize,
     /// Regions the winding-number rule would have filled but left open, their cap being too wide
     /// (see [`InitOptions::enclosure_max_cap_fraction`]).
     pub enclosures_left_open: usize,
@@ -430,6 +442,7 @@ fn watertight_init_from(
                 soup,
                 threshold,
                 options.enclosure_max_cap_fraction,
+                &options.scanner_views,
             );
         }
     };
@@ -482,6 +495,7 @@ fn watertight_init_from(
         nonmanifold_vertices_resolved: repair.vertices,
         voxels_added_for_manifoldness: repair.voxels_added,
         voxels_filled_by_winding: enclosed.filled,
+        voxels_hidden_from_scanners: enclosed.hidden,
         enclosures_left_open: enclosed.left_open,
         rejected_moves: projection.rejected_moves,
         mean_distance_to_target: projection.mean_distance,

@@ -43,6 +43,7 @@
 //! by the flood's gap closing already; the winding rule adds nothing there.
 
 use super::grid::{EXTERIOR, Grid, SOLID};
+use super::sight::{DepthMap, ScannerView, hidden_from_every_scanner};
 use super::solid;
 use glam::DVec3;
 use roar_mesh::spatial::WindingNumber;
@@ -53,6 +54,8 @@ use std::collections::{HashMap, HashSet};
 pub(crate) struct EnclosedFill {
     /// Exterior voxels whose winding number was evaluated.
     pub evaluated: usize,
+    /// Of those, the ones hidden from every scanner (module `sight`; 0 without scanner views).
+    pub hidden: usize,
     /// Voxels that turned solid (above the threshold, or cut off from the border by those).
     pub filled: usize,
     /// Regions above the threshold left exterior because their cap was too wide.
@@ -60,7 +63,7 @@ pub(crate) struct EnclosedFill {
 }
 
 /// Turns solid every exterior voxel of `state` whose centre has a winding number (of `soup`)
-/// above `threshold`, then floods the exterior again from the border so that exterior voxels the
+/// above `threshold` or is hidden from every one of `views` (module `sight`), then floods the exterior again from the border so that exterior voxels the
 /// new solid cut off turn solid too, and keeps each such region only if its widest cap is at most
 /// `max_cap_fraction` of its boundary (see the module doc). Only voxels inside the soup's bounding
 /// box are evaluated: outside it the winding number of a closed surface is 0 and that of open
@@ -74,6 +77,7 @@ pub(crate) fn fill_enclosed(
     soup: &[[DVec3; 3]],
     threshold: f64,
     max_cap_fraction: f64,
+    views: &[ScannerView],
 ) -> EnclosedFill {
     let oriented = first_of_each_twin_pair(soup);
     let positions: Vec<DVec3> = oriented.iter().flatten().copied().collect();
@@ -95,10 +99,17 @@ pub(crate) fn fill_enclosed(
         .collect();
     let points: Vec<DVec3> = candidates.iter().map(|&idx| center(idx)).collect();
     let values = winding.winding_numbers(&points);
+    let maps: Vec<DepthMap> = views
+        .iter()
+        .filter_map(|view| DepthMap::new(view, grid.voxel_size))
+        .collect();
     let mut blocked: Vec<u8> = state.iter().map(|&s| u8::from(s == SOLID)).collect();
     let mut above = 0;
-    for (&idx, &w) in candidates.iter().zip(&values) {
-        if w > threshold {
+    let mut hidden = 0;
+    for ((&idx, &w), &p) in candidates.iter().zip(&values).zip(&points) {
+        let is_hidden = hidden_from_every_scanner(&maps, p);
+        hidden += usize::from(is_hidden);
+        if w > threshold || is_hidden {
             blocked[idx] = 1;
             above += 1;
         }
@@ -116,6 +127,7 @@ pub(crate) fn fill_enclosed(
     let after = state.iter().filter(|&&s| s == SOLID).count();
     EnclosedFill {
         evaluated: candidates.len(),
+        hidden,
         filled: after - before,
         left_open,
     }
@@ -276,7 +288,7 @@ mod tests {
         let open = box_soup(DVec3::ZERO, DVec3::ONE, true);
         let mut state = flooded(&grid, &open);
         let solid_before = state.iter().filter(|&&s| s == SOLID).count();
-        let fill = fill_enclosed(&grid, &mut state, &open, 0.6, 1.0);
+        let fill = fill_enclosed(&grid, &mut state, &open, 0.6, 1.0, &[]);
         assert!(fill.filled > 0);
         // The inside of the cup (winding number about 0.8 at its centre) is solid now.
         let mid = grid.to_grid(DVec3::new(0.5, 0.5, 0.3)).floor();
@@ -290,7 +302,7 @@ mod tests {
         let closed = box_soup(DVec3::ZERO, DVec3::ONE, false);
         let mut state = flooded(&grid, &closed);
         let reference = state.clone();
-        let fill = fill_enclosed(&grid, &mut state, &closed, 0.6, 1.0);
+        let fill = fill_enclosed(&grid, &mut state, &closed, 0.6, 1.0, &[]);
         assert_eq!(fill.filled, 0);
         assert_eq!(state, reference);
     }
@@ -302,7 +314,7 @@ mod tests {
         let open = box_soup(DVec3::ZERO, DVec3::ONE, true);
         let mut state = flooded(&grid, &open);
         let reference = state.clone();
-        let fill = fill_enclosed(&grid, &mut state, &open, 0.6, 0.02);
+        let fill = fill_enclosed(&grid, &mut state, &open, 0.6, 0.02, &[]);
         assert_eq!((fill.filled, fill.left_open), (0, 1));
         assert_eq!(state, reference);
         // A closed box whose top lost the two triangles of one small square (wider than the
@@ -322,7 +334,7 @@ mod tests {
         }
         punctured.extend(top);
         let mut state = flooded(&grid, &punctured);
-        let fill = fill_enclosed(&grid, &mut state, &punctured, 0.6, 0.02);
+        let fill = fill_enclosed(&grid, &mut state, &punctured, 0.6, 0.02, &[]);
         assert!(fill.filled > 0 && fill.left_open == 0, "{fill:?}");
         let mid = grid.to_grid(DVec3::splat(0.5)).floor();
         assert_eq!(
@@ -340,7 +352,7 @@ mod tests {
         let twins: Vec<[DVec3; 3]> = doubled.iter().map(|t| [t[0], t[2], t[1]]).collect();
         doubled.extend(twins);
         let mut state = flooded(&grid, &doubled);
-        assert!(fill_enclosed(&grid, &mut state, &doubled, 0.6, 1.0).filled > 0);
+        assert!(fill_enclosed(&grid, &mut state, &doubled, 0.6, 1.0, &[]).filled > 0);
     }
 
     #[test]
@@ -351,7 +363,7 @@ mod tests {
         let sheet = vec![[DVec3::ZERO, a, b], [DVec3::ZERO, b, DVec3::Y]];
         let mut state = flooded(&grid, &sheet);
         let reference = state.clone();
-        let fill = fill_enclosed(&grid, &mut state, &sheet, 0.6, 1.0);
+        let fill = fill_enclosed(&grid, &mut state, &sheet, 0.6, 1.0, &[]);
         assert_eq!(fill.filled, 0);
         assert_eq!(state, reference);
     }
