@@ -353,7 +353,7 @@ fn a_cube_scanned_from_two_opposite_sides_is_solid_only_with_the_lines_of_sight(
     let shells = watertight_init(&soup.positions, &soup.triangles, &options).unwrap();
     let with_sight = InitOptions {
         scanner_views: vec![view(&top, DVec3::Z), view(&bottom, -DVec3::Z)],
-        ..options
+        ..options.clone()
     };
     let solid = watertight_init(&soup.positions, &soup.triangles, &with_sight).unwrap();
     let (pieces, genus) = pieces_and_genus(&solid);
@@ -371,4 +371,25 @@ fn a_cube_scanned_from_two_opposite_sides_is_solid_only_with_the_lines_of_sight(
     );
     assert_eq!((pieces, genus), (1, 0));
     assert!(volume(&solid) > 0.9, "volume {}", volume(&solid));
+    // Seen from above only, with a strip of the bottom (x < 0.3) measured by nothing that
+    // looks at it: the top hides the whole cube, but only the columns over the strip have
+    // measured surface behind them, so the shadow elsewhere (the unseen back of a set of scans
+    // taken from one side) is not claimed.
+    let strip: Vec<DVec3> = bottom
+        .positions
+        .iter()
+        .map(|p| DVec3::new(0.3 * p.x, p.y, p.z))
+        .collect();
+    let one_side = [top.positions.clone(), strip].concat();
+    let from_above = InitOptions {
+        scanner_views: vec![view(&top, DVec3::Z)],
+        ..options.clone()
+    };
+    let out = watertight_init(&one_side, &soup.triangles, &from_above).unwrap();
+    println!("seen from above only: volume {:.3}", volume(&out));
+    assert!(
+        volume(&out) < 0.45,
+        "the shadow was claimed: volume {}",
+        volume(&out)
+    );
 }

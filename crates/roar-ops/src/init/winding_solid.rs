@@ -101,7 +101,7 @@ pub(crate) fn fill_enclosed(
     let values = winding.winding_numbers(&points);
     let maps: Vec<DepthMap> = views
         .iter()
-        .filter_map(|view| DepthMap::new(view, grid.voxel_size))
+        .filter_map(|view| DepthMap::new(view, soup, grid.voxel_size))
         .collect();
     let mut blocked: Vec<u8> = state.iter().map(|&s| u8::from(s == SOLID)).collect();
     let mut above = 0;
