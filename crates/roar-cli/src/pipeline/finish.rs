@@ -15,7 +15,7 @@ use roar_ops::decimate::{DecimateOptions, DecimateStats, decimate};
 use roar_ops::finish::data_flips::{DataFlipOptions, flip_toward_target};
 use roar_ops::finish::degenerate::{DegenerateOptions, collapse_degenerate_faces};
 use roar_ops::finish::fill::fill_to_budget;
-use roar_ops::finish::genus::{HandleRemovalOptions, decimate_removing_handles};
+use roar_ops::finish::genus::{HandleRemovalOptions, decimate_removing_handles, remove_handles};
 use roar_ops::finish::offset::offset_outward;
 use roar_ops::finish::slivers::{SliverOptions, flip_slivers};
 use roar_ops::untangle::{UntangleOptions, UntangleStats, untangle};
@@ -172,8 +172,9 @@ fn finish_budgets(faces: usize, budget: usize, polishing: bool) -> Vec<usize> {
 
 /// The guaranteed QEM to exactly `faces` (best effort only if configured). Unless
 /// `keep_topology`, handles are removed (shortest loop first, `roar_ops::finish::genus`) when the genus
-/// needs more faces than `faces` or the QEM stalls above it; each removal is noted on stderr and
-/// recorded in `stats.handles_removed`.
+/// needs more faces than `faces` or the QEM stalls above it, then the crossings of the cuts are
+/// untangled; when some stay, the whole step is retried with more handles removed first. Each
+/// removal is noted on stderr and recorded in `stats.handles_removed`.
 fn final_decimation(
     mesh: &mut Mesh,
     faces: usize,
@@ -187,25 +188,56 @@ fn final_decimation(
     let decimated = if config.finish.keep_topology {
         decimate(mesh, faces, &options)?
     } else {
-        let (decimated, removed) = decimate_removing_handles(
-            mesh,
-            faces,
-            &options,
-            &HandleRemovalOptions::default(),
-            decimate,
-        )?;
-        for handle in &removed {
-            eprintln!(
-                "note: removed a handle to reach {faces} faces (cut along a loop of {} edges, \
-                 length {:.4} in the unit sphere; --keep-topology fails instead)",
-                handle.loop_vertices, handle.loop_length
-            );
+        // The caps of the cuts and the QEM after them can leave crossings that the untangle
+        // cannot clear when many handles meet a small budget (a random soup at 500 faces, 62
+        // handles). Each retry starts again from the mesh as it came with more handles removed
+        // first (1, 2, 4, … beyond those the budget needs), which leaves the QEM more room.
+        let original = mesh.clone();
+        let mut extra = 0;
+        loop {
+            let mut removed = if extra > 0 {
+                remove_handles(mesh, extra, &HandleRemovalOptions::default()).unwrap_or_default()
+            } else {
+                Vec::new()
+            };
+            let (decimated, needed) = decimate_removing_handles(
+                mesh,
+                faces,
+                &options,
+                &HandleRemovalOptions::default(),
+                decimate,
+            )?;
+            removed.extend(needed);
+            let untangled = if removed.is_empty() {
+                Ok(())
+            } else {
+                untangle_cut_caps(mesh, faces, config)
+            };
+            match untangled {
+                Err(PipelineError::Intersections(n)) if extra < original.genus() => {
+                    extra = (2 * extra).max(1);
+                    eprintln!(
+                        "note: {n} faces still crossed after removing {} handles; trying again \
+                         with {extra} more removed first",
+                        removed.len()
+                    );
+                    *mesh = original.clone();
+                }
+                Err(error) => return Err(error),
+                Ok(()) => {
+                    for handle in &removed {
+                        eprintln!(
+                            "note: removed a handle to reach {faces} faces (cut along a loop of \
+                             {} edges, length {:.4} in the unit sphere; --keep-topology fails \
+                             instead)",
+                            handle.loop_vertices, handle.loop_length
+                        );
+                    }
+                    stats.finish.handles_removed.extend(removed);
+                    break decimated;
+                }
+            }
         }
-        if !removed.is_empty() {
-            untangle_cut_caps(mesh, faces, config)?;
-        }
-        stats.finish.handles_removed.extend(removed);
-        decimated
     };
     if mesh.n_faces() != faces && !config.finish.best_effort {
         return Err(PipelineError::Internal(format!(
