@@ -218,8 +218,7 @@ fn linear(
     inputs: usize,
     outputs: Option<usize>,
 ) -> Result<(Array2<f32>, Array1<f32>), String> {
-    let names: BTreeSet<&str> = tensors.names().into_iter().collect();
-    let has = |suffix: &str| names.contains(format!("{key}.{suffix}").as_str());
+    let has = |suffix: &str| tensors.tensor(&format!("{key}.{suffix}")).is_ok();
     let (weight_name, w) = if has("weight") {
         let name = format!("{key}.weight");
         let w = matrix(tensors, &name)?;
@@ -274,9 +273,6 @@ fn linear(
         ));
     }
     let bias_name = format!("{key}.bias");
-    if !names.contains(bias_name.as_str()) {
-        return Err(format!("{bias_name} is missing"));
-    }
     let b = Array1::from(values(tensors, &bias_name)?);
     if b.len() != w.nrows() {
         return Err(format!(

@@ -193,13 +193,9 @@ fn final_decimation(
         // handles). Each retry starts again from the mesh as it came with more handles removed
         // first (1, 2, 4, … beyond those the budget needs), which leaves the QEM more room.
         let original = mesh.clone();
-        let mut extra = 0;
+        let genus = original.genus();
+        let mut removed_first = Vec::new();
         loop {
-            let mut removed = if extra > 0 {
-                remove_handles(mesh, extra, &HandleRemovalOptions::default()).unwrap_or_default()
-            } else {
-                Vec::new()
-            };
             let (decimated, needed) = decimate_removing_handles(
                 mesh,
                 faces,
@@ -207,6 +203,7 @@ fn final_decimation(
                 &HandleRemovalOptions::default(),
                 decimate,
             )?;
+            let mut removed = removed_first.clone();
             removed.extend(needed);
             let untangled = if removed.is_empty() {
                 Ok(())
@@ -214,16 +211,6 @@ fn final_decimation(
                 untangle_cut_caps(mesh, faces, config)
             };
             match untangled {
-                Err(PipelineError::Intersections(n)) if extra < original.genus() => {
-                    extra = (2 * extra).max(1);
-                    eprintln!(
-                        "note: {n} faces still crossed after removing {} handles; trying again \
-                         with {extra} more removed first",
-                        removed.len()
-                    );
-                    *mesh = original.clone();
-                }
-                Err(error) => return Err(error),
                 Ok(()) => {
                     for handle in &removed {
                         eprintln!(
@@ -236,6 +223,23 @@ fn final_decimation(
                     stats.finish.handles_removed.extend(removed);
                     break decimated;
                 }
+                Err(PipelineError::Intersections(n)) if removed_first.len() < genus => {
+                    let more = (2 * removed_first.len()).max(1);
+                    eprintln!(
+                        "note: {n} faces still crossed after removing {} handles; trying again \
+                         with {more} more removed first",
+                        removed.len()
+                    );
+                    *mesh = original.clone();
+                    let first = remove_handles(mesh, more, &HandleRemovalOptions::default());
+                    // No progress (no handle could be cut): the crossings stay, and so does
+                    // the error.
+                    match first {
+                        Ok(first) if first.len() > removed_first.len() => removed_first = first,
+                        _ => return Err(PipelineError::Intersections(n)),
+                    }
+                }
+                Err(error) => return Err(error),
             }
         }
     };
