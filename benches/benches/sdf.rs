@@ -1,6 +1,8 @@
 //! SDF inputs: batched network evaluation (values with input gradients, in points per second)
-//! for 8 × 64 and 8 × 256 MLPs with random weights, and one SDF-loss evaluation on the 25,002
-//! vertices of a 50,000-face mesh (a subdivided sphere) over the 8 × 64 network.
+//! for 8 × 64 and 8 × 256 sequential MLPs with random weights and for an IDR-sized implicit
+//! network (8 × 256, positional encoding with 6 frequencies, a skip into layer 4, softplus β
+//! 100), read from a `.safetensors` file the bench writes; and one SDF-loss evaluation on the
+//! 25,002 vertices of a 50,000-face mesh (a subdivided sphere) over the 8 × 64 network.
 
 use std::sync::Arc;
 
@@ -33,6 +35,52 @@ fn network(width: usize) -> Mlp {
     Mlp::from_layers(layers, Activation::Elu)
 }
 
+/// IDR's geometry network at its paper size (`d_hidden` 256, `n_layers` 8, `skip_in` [4],
+/// `multires` 6) with random weights, written as a PyTorch state dict in `.safetensors` with
+/// its sidecar, and read back as `roar reconstruct` reads it.
+fn idr_network() -> Mlp {
+    let (width, layers, skip, multires) = (256usize, 8usize, 4usize, 6usize);
+    let encoded = 3 * (1 + 2 * multires);
+    let mut rng = ChaCha8Rng::seed_from_u64(3);
+    let mut tensors: Vec<(String, Vec<usize>, Vec<u8>)> = Vec::new();
+    for l in 0..=layers {
+        let inputs = if l == 0 { encoded } else { width };
+        let outputs = match l {
+            l if l == layers => 1,
+            l if l + 1 == skip => width - encoded,
+            _ => width,
+        };
+        let scale = (2.0 / inputs as f32).sqrt();
+        let mut random = |n: usize, scale: f32| -> Vec<u8> {
+            (0..n)
+                .flat_map(|_| (scale * rng.random_range(-1.0f32..1.0)).to_le_bytes())
+                .collect()
+        };
+        tensors.push((
+            format!("lin{l}.weight"),
+            vec![outputs, inputs],
+            random(outputs * inputs, scale),
+        ));
+        tensors.push((format!("lin{l}.bias"), vec![outputs], random(outputs, 0.1)));
+    }
+    let views = tensors.iter().map(|(name, shape, bytes)| {
+        let view =
+            safetensors::tensor::TensorView::new(safetensors::Dtype::F32, shape.clone(), bytes)
+                .expect("a tensor view");
+        (name.clone(), view)
+    });
+    let dir = tempfile::tempdir().expect("a temporary folder");
+    let path = dir.path().join("idr.safetensors");
+    safetensors::tensor::serialize_to_file(views, None, &path).expect("writing the network");
+    let sidecar = format!(
+        "{{\"d_hidden\": {width}, \"n_layers\": {layers}, \"skip_in\": [{skip}], \"multires\": {multires}}}"
+    );
+    std::fs::write(dir.path().join("idr.json"), sidecar).expect("writing the sidecar");
+    roar_sdf::implicit_network::read_implicit_network(&path)
+        .expect("reading the network back")
+        .0
+}
+
 fn sdf_benches(c: &mut Criterion) {
     let mut rng = ChaCha8Rng::seed_from_u64(2);
     let points: Vec<DVec3> = (0..65_536)
@@ -51,6 +99,14 @@ fn sdf_benches(c: &mut Criterion) {
             b.iter(|| mlp.values(&points, &mut values))
         });
     }
+    let idr = idr_network();
+    group.bench_function("idr_8x256_multires6_values_and_gradients", |b| {
+        b.iter(|| evaluate_with_gradients(&idr, &points))
+    });
+    let mut values = vec![0.0; points.len()];
+    group.bench_function("idr_8x256_multires6_values", |b| {
+        b.iter(|| idr.values(&points, &mut values))
+    });
     // icosphere(6): 40,962 vertices / 81,920 faces; level 5 has 20,480 faces. The loss reads
     // vertices only: 25,002 vertices is the vertex count of a closed genus-0 50k-face mesh.
     let sphere = icosphere(6);

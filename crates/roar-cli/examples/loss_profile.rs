@@ -249,6 +249,8 @@ fn eval(mesh: &Path, state: &Path, evals: usize, term: &str) -> anyhow::Result<(
                 default_loss(&Prepared {
                     cameras: &target.cameras,
                     renders: &target.renders,
+                    coarse_cameras: &[],
+                    coarse_renders: &[],
                     cloud: &cloud,
                     signed_distance: None,
                     config: &config,

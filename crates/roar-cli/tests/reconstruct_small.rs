@@ -145,17 +145,33 @@ fn toy_reconstruction_is_closed_exact_and_intersection_free() {
     }
 }
 
+/// The bits of every coordinate.
+fn bits(p: &[glam::DVec3]) -> Vec<u64> {
+    p.iter()
+        .flat_map(|v| v.to_array().map(f64::to_bits))
+        .collect()
+}
+
 #[test]
 fn same_input_config_and_seed_give_the_same_bits() {
     let a = run(toy_config(200));
     let b = run(toy_config(200));
     assert_eq!(a.1, b.1);
-    let bits = |p: &[glam::DVec3]| {
-        p.iter()
-            .flat_map(|v| v.to_array().map(f64::to_bits))
-            .collect::<Vec<_>>()
-    };
     assert_eq!(bits(&a.0), bits(&b.0));
+}
+
+#[test]
+fn the_output_does_not_depend_on_the_number_of_threads() {
+    let in_pool = |threads: usize| {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap()
+            .install(|| run(toy_config(200)))
+    };
+    let (one, two) = (in_pool(1), in_pool(2));
+    assert_eq!(one.1, two.1);
+    assert_eq!(bits(&one.0), bits(&two.0));
 }
 
 #[test]

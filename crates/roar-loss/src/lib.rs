@@ -27,7 +27,7 @@ pub mod target;
 pub use point_cloud::{
     PointCloud, PointCloudOptions, point_cloud, point_cloud_of_soup, two_sided_faces,
 };
-pub use render_loss::RenderLoss;
+pub use render_loss::{CoarseViews, RenderLoss};
 pub use roar_mesh::spatial::{Sdf, SdfEvaluations};
 pub use sdf_loss::{SdfLoss, SdfLossOptions};
 pub use shape::{InitialMesh, Shape, ShapeError, ShapeSummary};

@@ -23,6 +23,25 @@ pub struct RenderLoss {
     pub options: RenderOptions,
     /// The per-channel penalty (spec §3.2.1: L1).
     pub kind: LossKind,
+    /// A coarser rig for the loop's first iterations (none: `cameras` throughout).
+    pub coarse: Option<CoarseViews>,
+    /// The iteration the next evaluations belong to ([`Loss::set_iteration`]).
+    iteration: usize,
+}
+
+/// The same views at a lower resolution, with their own target renders, used while the
+/// iteration is below `until`. The loss is a mean over pixels, so its value and gradient keep
+/// their scale at any resolution, while a view costs less than half at half the side
+/// (`docs/method.md`). Values on either side of `until` are close but not equal, which matters
+/// only where they are compared (the loop's checkpoints).
+#[derive(Clone, Debug)]
+pub struct CoarseViews {
+    /// The coarse cameras, one per fine camera.
+    pub cameras: Vec<Camera>,
+    /// One target image per coarse camera.
+    pub targets: Vec<Image>,
+    /// The first iteration rendered with the fine cameras.
+    pub until: usize,
 }
 
 impl RenderLoss {
@@ -41,7 +60,15 @@ impl RenderLoss {
             targets: renders.to_vec(),
             options: RenderOptions::default(),
             kind: LossKind::L1,
+            coarse: None,
+            iteration: 0,
         }
+    }
+
+    /// The same loss rendering `coarse` instead until iteration `coarse.until`.
+    pub fn with_coarse(mut self, coarse: CoarseViews) -> Self {
+        self.coarse = Some(coarse);
+        self
     }
 }
 
@@ -55,13 +82,21 @@ impl Loss for RenderLoss {
         positions: &[DVec3],
         triangles: &[[u32; 3]],
     ) -> Result<(f64, Vec<DVec3>), LossError> {
+        let (cameras, targets) = match &self.coarse {
+            Some(coarse) if self.iteration < coarse.until => (&coarse.cameras, &coarse.targets),
+            _ => (&self.cameras, &self.targets),
+        };
         Ok(render_loss_and_grad(
             positions,
             triangles,
-            &self.cameras,
-            &self.targets,
+            cameras,
+            targets,
             &self.options,
             self.kind,
         )?)
+    }
+
+    fn set_iteration(&mut self, iteration: usize) {
+        self.iteration = iteration;
     }
 }

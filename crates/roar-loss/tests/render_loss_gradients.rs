@@ -5,7 +5,7 @@ mod common;
 
 use common::{Lcg, sphere};
 use glam::DVec3;
-use roar_loss::{Loss, RenderLoss, TargetOptions, build_target, render_views};
+use roar_loss::{CoarseViews, Loss, RenderLoss, TargetOptions, build_target, render_views};
 use roar_render::{Camera, Image, LossKind, RenderOptions, render, star_cameras};
 
 /// A sphere with a smooth bump, so the source differs from the target in shading and outline.
@@ -23,12 +23,10 @@ fn loss_against(
     cameras: Vec<Camera>,
     kind: LossKind,
 ) -> RenderLoss {
-    RenderLoss {
-        targets: render_views(&target.0, &target.1, &cameras, true).unwrap(),
-        cameras,
-        options: RenderOptions::default(),
-        kind,
-    }
+    let targets = render_views(&target.0, &target.1, &cameras, true).unwrap();
+    let mut loss = RenderLoss::from_renders(&cameras, &targets);
+    loss.kind = kind;
+    loss
 }
 
 /// Discrete state of one view: ids, (target, source, edge, branch) of every AA blend, and the
@@ -172,4 +170,34 @@ fn new_uses_the_targets_rig_and_renders() {
         loss.value_and_grad(&target.positions, &[[0, 1, 99_999]])
             .is_err()
     );
+}
+
+#[test]
+fn coarse_views_render_the_first_iterations_then_the_full_rig() {
+    let target = sphere(2, 0.8);
+    let (pos, tris) = source(9);
+    let fine = star_cameras(3, 2, 96, 96);
+    let coarse = star_cameras(3, 2, 48, 48);
+    let mut only_fine = loss_against(&target, fine.clone(), LossKind::L1);
+    let mut only_coarse = loss_against(&target, coarse.clone(), LossKind::L1);
+    let mut scheduled = loss_against(&target, fine, LossKind::L1).with_coarse(CoarseViews {
+        targets: only_coarse.targets.clone(),
+        cameras: coarse,
+        until: 3,
+    });
+    let (fine_value, fine_grad) = only_fine.value_and_grad(&pos, &tris).unwrap();
+    let (coarse_value, coarse_grad) = only_coarse.value_and_grad(&pos, &tris).unwrap();
+    for (iteration, expected) in [(0, &coarse_grad), (2, &coarse_grad), (3, &fine_grad)] {
+        scheduled.set_iteration(iteration);
+        let (_, grad) = scheduled.value_and_grad(&pos, &tris).unwrap();
+        assert_eq!(&grad, expected, "iteration {iteration}");
+    }
+    // A mean over pixels: half the side changes the value and the gradient's size little.
+    assert!(
+        (coarse_value / fine_value - 1.0).abs() < 0.2,
+        "{coarse_value} vs {fine_value}"
+    );
+    let size = |g: &[DVec3]| g.iter().map(|g| g.length()).sum::<f64>();
+    let ratio = size(&coarse_grad) / size(&fine_grad);
+    assert!((ratio - 1.0).abs() < 0.3, "gradient size ratio {ratio}");
 }

@@ -188,6 +188,15 @@ pub struct LossConfig {
     pub planar_neighbours: usize,
     /// Include the target-to-source term (OQ-3).
     pub planar_t2s: bool,
+    /// Side in pixels of the coarse views the render loss uses for the loop's first
+    /// `render_coarse_fraction` of iterations, when below `render_resolution`
+    /// (`roar_loss::CoarseViews`; the paper renders every iteration at `render_resolution`,
+    /// `docs/method.md` says why not). Default 256.
+    pub render_coarse_resolution: u32,
+    /// Fraction of the loop's iterations rendered at `render_coarse_resolution`, from the
+    /// first (0: none, the paper's schedule; the finish's polish always renders at
+    /// `render_resolution`). Default 1: the whole loop.
+    pub render_coarse_fraction: f64,
     /// Weight of the SDF projection loss (§5: 0.1), in the objective only for inputs with a
     /// signed distance (`roar_loss::SdfLoss`).
     pub sdf_loss_weight: f64,
@@ -206,6 +215,8 @@ impl Default for LossConfig {
             planar_max_samples: roar_loss::planar::DEFAULT_MAX_SAMPLES,
             planar_neighbours: 10,
             planar_t2s: true,
+            render_coarse_resolution: 256,
+            render_coarse_fraction: 1.0,
             sdf_loss_weight: 0.1,
             sdf_loss_start: 500,
             sdf_loss_epsilon: 1e-10,
@@ -515,6 +526,14 @@ impl ReconstructConfig {
             ),
             (r("target.twin_ratio", 1.0, 1e6), self.target.twin_ratio),
             (r("loss.render_weight", 0.0, 1e6), self.loss.render_weight),
+            (
+                r("loss.render_coarse_resolution", 16.0, 4096.0),
+                f64::from(self.loss.render_coarse_resolution),
+            ),
+            (
+                r("loss.render_coarse_fraction", 0.0, 1.0),
+                self.loss.render_coarse_fraction,
+            ),
             (r("loss.planar_weight", 0.0, 1e6), self.loss.planar_weight),
             (r("loss.planar_scale", 0.0, 1e9), self.loss.planar_scale),
             (
@@ -833,12 +852,19 @@ mod tests {
         assert_eq!(c.target.twin_ratio, 80.0);
         assert_eq!((c.loss.render_weight, c.loss.planar_weight), (3.0, 1.0));
         assert_eq!(c.loss.planar_scale, 500.0);
-        assert_eq!(c.loss.planar_max_samples, 50_000);
+        assert_eq!(c.loss.planar_max_samples, 25_000);
         assert_eq!(
             c.loss.planar_max_samples,
             roar_loss::planar::DEFAULT_MAX_SAMPLES
         );
         assert_eq!(c.loss.planar_neighbours, 10);
+        assert_eq!(
+            (
+                c.loss.render_coarse_resolution,
+                c.loss.render_coarse_fraction
+            ),
+            (256, 1.0)
+        );
         assert_eq!(c.target.point_cloud_samples, 200_000);
         assert_eq!(c.target.sheet_offset, 1e-3);
         assert_eq!(c.target.sharp_edge_samples, 30_000);

@@ -32,8 +32,8 @@ use std::time::Instant;
 
 use glam::DVec3;
 use roar_loss::{
-    KnnOptions, Loss, LossError, PlanarLoss, PlanarOptions, PointCloud, RenderLoss, Sdf, SdfLoss,
-    SdfLossOptions, Shape, ShapeError, TargetOptions, WeightedSum,
+    CoarseViews, KnnOptions, Loss, LossError, PlanarLoss, PlanarOptions, PointCloud, RenderLoss,
+    Sdf, SdfLoss, SdfLossOptions, Shape, ShapeError, TargetOptions, WeightedSum,
 };
 use roar_mesh::spatial::Projector;
 use roar_ops::blocks::block::Block;
@@ -93,6 +93,11 @@ pub struct Prepared<'a> {
     pub cameras: &'a [Camera],
     /// The shape's target normal map for each camera.
     pub renders: &'a [Image],
+    /// The coarse rig of the loop's first iterations ([`coarse_rig_cameras`]; empty when the
+    /// config has none) and the shape's renders for it.
+    pub coarse_cameras: &'a [Camera],
+    /// See `coarse_cameras`.
+    pub coarse_renders: &'a [Image],
     /// The oriented target point cloud P (with the sharp-edge samples).
     pub cloud: &'a PointCloud,
     /// The shape's signed distance, if it has one.
@@ -366,6 +371,23 @@ pub fn rig_cameras(config: &ReconstructConfig) -> Vec<Camera> {
     )
 }
 
+/// The coarse rig of `config`: the rig's views at `render_coarse_resolution²` pixels, for the
+/// loop's first `render_coarse_fraction` of iterations; empty when that fraction rounds to no
+/// iteration or the resolution is not below `render_resolution`.
+pub fn coarse_rig_cameras(config: &ReconstructConfig) -> Vec<Camera> {
+    let resolution = config.loss.render_coarse_resolution;
+    if coarse_until(config) == 0 || resolution >= config.target.render_resolution {
+        return Vec::new();
+    }
+    let views = config.target.views_per_axis;
+    star_cameras(views, views, resolution, resolution)
+}
+
+/// The first loop iteration rendered with the full rig.
+fn coarse_until(config: &ReconstructConfig) -> usize {
+    (config.loss.render_coarse_fraction * config.optimize.iterations as f64).round() as usize
+}
+
 /// The target renders' options of `config` (spec §3.1, §3.2.1), as the pipeline uses them.
 pub fn target_options(config: &ReconstructConfig) -> TargetOptions {
     TargetOptions {
@@ -399,11 +421,16 @@ pub fn default_loss(prepared: &Prepared) -> Result<Box<dyn Loss>, PipelineError>
         &prepared.cloud.normals,
         &planar_options(config),
     )?;
+    let mut render = RenderLoss::from_renders(prepared.cameras, prepared.renders);
+    if !prepared.coarse_cameras.is_empty() {
+        render = render.with_coarse(CoarseViews {
+            cameras: prepared.coarse_cameras.to_vec(),
+            targets: prepared.coarse_renders.to_vec(),
+            until: coarse_until(config),
+        });
+    }
     let mut sum = WeightedSum::default()
-        .with(
-            config.loss.render_weight,
-            Box::new(RenderLoss::from_renders(prepared.cameras, prepared.renders)),
-        )
+        .with(config.loss.render_weight, Box::new(render))
         .with(config.loss.planar_weight, Box::new(planar));
     if let Some(sdf) = &prepared.signed_distance {
         let options = SdfLossOptions {
@@ -526,5 +553,30 @@ impl StageClock {
         let since = self.last.unwrap_or(now);
         *self.seconds.entry(stage.to_string()).or_insert(0.0) += (now - since).as_secs_f64();
         self.last = Some(now);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_coarse_rig_is_the_rig_at_the_coarse_resolution_for_the_loops_first_iterations() {
+        let mut config = ReconstructConfig::default();
+        let (fine, coarse) = (rig_cameras(&config), coarse_rig_cameras(&config));
+        assert_eq!(coarse.len(), fine.len());
+        for (c, f) in coarse.iter().zip(&fine) {
+            assert_eq!((c.width, c.height), (256, 256));
+            assert_eq!((c.view, c.proj), (f.view, f.proj));
+        }
+        assert_eq!(coarse_until(&config), 200, "the whole loop by default");
+        config.loss.render_coarse_fraction = 0.5;
+        assert_eq!(coarse_until(&config), 100);
+        // None when it would not be coarser, or would render no iteration.
+        config.target.render_resolution = 256;
+        assert!(coarse_rig_cameras(&config).is_empty());
+        config.target.render_resolution = 512;
+        config.loss.render_coarse_fraction = 0.0;
+        assert!(coarse_rig_cameras(&config).is_empty());
     }
 }

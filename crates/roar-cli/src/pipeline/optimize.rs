@@ -2,17 +2,20 @@
 //! of Move Vertices steps and scheduled blocks, keeping a checkpoint state every
 //! `checkpoint_interval` iterations and the last state, each with its loss, for the finish.
 
+use std::borrow::Cow;
+
 use roar_loss::{KnnOptions, KnnPlanarProjector, Loss, LossError, PointCloud, Shape};
 use roar_mesh::spatial::Projector;
 use roar_mesh::{Mesh, TrackedMesh};
 use roar_ops::blocks::block::{BlockContext, BlockStats};
 use roar_ops::optim::{Optimizer, OptimizerOptions};
 use roar_ops::untangle::{LimiterOptions, limit_steps};
+use roar_render::{Camera, Image};
 
 use super::prepare::Target;
 use super::{
     IterationRecord, LossFactory, PipelineError, Prepared, ReconstructConfig, Run, RunStats,
-    ScheduledBlock, StageClock,
+    ScheduledBlock, StageClock, coarse_rig_cameras,
 };
 
 /// The loss the loop minimizes and the k-NN planar projector over the point cloud (the
@@ -32,23 +35,19 @@ pub(super) fn objective(
 ) -> Result<Objective, PipelineError> {
     let config = run.config;
     let cameras = &target.cameras;
-    let renders = shape.target_renders(cameras)?;
-    if renders.len() != cameras.len() {
-        return Err(PipelineError::Loss(LossError::InvalidTarget(format!(
-            "{}: {} target renders for {} cameras",
-            shape.name(),
-            renders.len(),
-            cameras.len()
-        ))));
-    }
+    let renders = target_renders(shape, cameras)?;
+    let coarse_cameras = coarse_rig_cameras(config);
+    let coarse_renders = target_renders(shape, &coarse_cameras)?;
     let loss = loss_factory(&Prepared {
         cameras,
         renders: &renders,
+        coarse_cameras: &coarse_cameras,
+        coarse_renders: &coarse_renders,
         cloud,
         signed_distance: shape.signed_distance(),
         config,
     })?;
-    drop(renders);
+    drop((renders, coarse_renders));
     let projector = KnnPlanarProjector::new(
         &cloud.points,
         &cloud.normals,
@@ -58,6 +57,26 @@ pub(super) fn objective(
         },
     )?;
     Ok(Objective { loss, projector })
+}
+
+/// The shape's target renders for `cameras`, one per camera.
+fn target_renders<'s>(
+    shape: &'s dyn Shape,
+    cameras: &[Camera],
+) -> Result<Cow<'s, [Image]>, PipelineError> {
+    if cameras.is_empty() {
+        return Ok(Cow::Borrowed(&[]));
+    }
+    let renders = shape.target_renders(cameras)?;
+    if renders.len() != cameras.len() {
+        return Err(PipelineError::Loss(LossError::InvalidTarget(format!(
+            "{}: {} target renders for {} cameras",
+            shape.name(),
+            renders.len(),
+            cameras.len()
+        ))));
+    }
+    Ok(renders)
 }
 
 /// Runs `config.iterations` iterations of the loop on `mesh` (a Move Vertices step, then the

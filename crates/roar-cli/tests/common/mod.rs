@@ -7,7 +7,8 @@ pub mod gltf;
 
 use roar_cli::pipeline::{InitConfig, LossConfig, OptimizeConfig, ReconstructConfig, TargetConfig};
 
-/// Few views, low resolutions, few iterations (as `reconstruct_small` uses), at `faces`.
+/// Few views, low resolutions (the loop's views at 32², the polish's at 64²), few iterations
+/// (as `reconstruct_small` uses), at `faces`.
 pub fn toy_config(faces: usize, iterations: usize) -> ReconstructConfig {
     ReconstructConfig {
         faces,
@@ -25,6 +26,7 @@ pub fn toy_config(faces: usize, iterations: usize) -> ReconstructConfig {
         },
         loss: LossConfig {
             planar_max_samples: 5000,
+            render_coarse_resolution: 32,
             ..Default::default()
         },
         optimize: OptimizeConfig {
