@@ -194,8 +194,9 @@ pub struct LossConfig {
     /// `docs/method.md` says why not). Default 256.
     pub render_coarse_resolution: u32,
     /// Fraction of the loop's iterations rendered at `render_coarse_resolution`, from the
-    /// first (0: none, the paper's schedule; the finish's polish always renders at
-    /// `render_resolution`). Default 1: the whole loop.
+    /// first (the finish's polish always renders at `render_resolution`). Default 0: none,
+    /// the paper's schedule; 1 with `planar_max_samples = 25000` is the faster schedule of
+    /// `docs/method.md`.
     pub render_coarse_fraction: f64,
     /// Weight of the SDF projection loss (§5: 0.1), in the objective only for inputs with a
     /// signed distance (`roar_loss::SdfLoss`).
@@ -216,7 +217,7 @@ impl Default for LossConfig {
             planar_neighbours: 10,
             planar_t2s: true,
             render_coarse_resolution: 256,
-            render_coarse_fraction: 1.0,
+            render_coarse_fraction: 0.0,
             sdf_loss_weight: 0.1,
             sdf_loss_start: 500,
             sdf_loss_epsilon: 1e-10,
@@ -852,7 +853,7 @@ mod tests {
         assert_eq!(c.target.twin_ratio, 80.0);
         assert_eq!((c.loss.render_weight, c.loss.planar_weight), (3.0, 1.0));
         assert_eq!(c.loss.planar_scale, 500.0);
-        assert_eq!(c.loss.planar_max_samples, 25_000);
+        assert_eq!(c.loss.planar_max_samples, 50_000);
         assert_eq!(
             c.loss.planar_max_samples,
             roar_loss::planar::DEFAULT_MAX_SAMPLES
@@ -863,7 +864,7 @@ mod tests {
                 c.loss.render_coarse_resolution,
                 c.loss.render_coarse_fraction
             ),
-            (256, 1.0)
+            (256, 0.0)
         );
         assert_eq!(c.target.point_cloud_samples, 200_000);
         assert_eq!(c.target.sheet_offset, 1e-3);
