@@ -47,7 +47,10 @@ proptest! {
     ) {
         let mut mesh = random_mesh(kind, genus, jitter, seed, two_pieces);
         let pieces = mesh.components().0;
-        let options = HandleRemovalOptions { roots };
+        let options = HandleRemovalOptions {
+            roots,
+            ..HandleRemovalOptions::default()
+        };
         while mesh.genus() > 0 {
             let before = mesh.genus();
             let removed = remove_handles(&mut mesh, 1, &options).unwrap();

@@ -172,8 +172,9 @@ fn finish_budgets(faces: usize, budget: usize, polishing: bool) -> Vec<usize> {
 
 /// The guaranteed QEM to exactly `faces` (best effort only if configured). Unless
 /// `keep_topology`, handles are removed (shortest loop first, `roar_ops::finish::genus`) when the genus
-/// needs more faces than `faces` or the QEM stalls above it, then the crossings of the cuts are
-/// untangled; when some stay, the whole step is retried with more handles removed first. Each
+/// needs more faces than `faces` or the QEM stalls above it, the crossings of each cut untangled
+/// at once and again at the end; when some stay, the whole step is retried with more handles
+/// removed first. Each
 /// removal is noted on stderr and recorded in `stats.handles_removed`.
 fn final_decimation(
     mesh: &mut Mesh,
@@ -188,21 +189,21 @@ fn final_decimation(
     let decimated = if config.finish.keep_topology {
         decimate(mesh, faces, &options)?
     } else {
-        // The caps of the cuts and the QEM after them can leave crossings that the untangle
-        // cannot clear when many handles meet a small budget (a random soup at 500 faces, 62
-        // handles). Each retry starts again from the mesh as it came with more handles removed
-        // first (1, 2, 4, … beyond those the budget needs), which leaves the QEM more room.
+        // A cut whose caps cross the surface is untangled at once, but at a small budget the
+        // untangle may lack the faces to clear it (a random soup at 500 faces, 45 handles).
+        // Each retry starts again from the mesh as it came and makes first, on that larger
+        // mesh, as many cuts as the failed attempt made in all (at least one more than the
+        // previous retry), so that the caps are untangled while there is room.
         let original = mesh.clone();
         let genus = original.genus();
+        let handles = HandleRemovalOptions {
+            untangle: Some(untangle_options(config)),
+            ..HandleRemovalOptions::default()
+        };
         let mut removed_first = Vec::new();
         loop {
-            let (decimated, needed) = decimate_removing_handles(
-                mesh,
-                faces,
-                &options,
-                &HandleRemovalOptions::default(),
-                decimate,
-            )?;
+            let (decimated, needed) =
+                decimate_removing_handles(mesh, faces, &options, &handles, decimate)?;
             let mut removed = removed_first.clone();
             removed.extend(needed);
             let untangled = if removed.is_empty() {
@@ -224,14 +225,14 @@ fn final_decimation(
                     break decimated;
                 }
                 Err(PipelineError::Intersections(n)) if removed_first.len() < genus => {
-                    let more = (2 * removed_first.len()).max(1);
+                    let more = removed.len().max(removed_first.len() + 1);
                     eprintln!(
                         "note: {n} faces still crossed after removing {} handles; trying again \
-                         with {more} more removed first",
+                         with {more} removed first",
                         removed.len()
                     );
                     *mesh = original.clone();
-                    let first = remove_handles(mesh, more, &HandleRemovalOptions::default());
+                    let first = remove_handles(mesh, more, &handles);
                     // No progress (no handle could be cut): the crossings stay, and so does
                     // the error.
                     match first {

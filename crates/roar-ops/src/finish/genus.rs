@@ -13,7 +13,8 @@
 //! Whittlesey 2005), so the
 //! handle removed is a thin one: cutting it changes the least surface. A cut whose moved rims
 //! or caps would cross the surface nearby gives way to the next shortest loop that crosses
-//! nothing (the shortest is cut when every loop crosses; the pipeline untangles after it).
+//! nothing (the shortest is cut when every loop crosses; with [`HandleRemovalOptions::untangle`]
+//! its crossings are untangled at once, while the mesh still has the faces to move apart).
 //!
 //! **Cut and cap.** Every loop vertex is split in two: the faces on the loop's left keep one
 //! copy, those on its right the other; each copy moves a fifth of the loop's mean edge length
@@ -21,6 +22,8 @@
 //! centroid. The result is a closed, oriented 2-manifold with the same components and genus − 1.
 
 use crate::decimate::{DecimateError, DecimateOptions, DecimateStats, minimum_faces};
+use crate::finish::fill::fill_to_budget;
+use crate::untangle::{UntangleOptions, untangle};
 use glam::DVec3;
 use roar_mesh::spatial::count_intersecting_faces;
 use roar_mesh::{HalfedgeId, Mesh, VertexId};
@@ -42,11 +45,18 @@ pub struct HandleRemovalOptions {
     /// its vertex order). More roots find shorter loops at a proportional cost (one Dijkstra
     /// and one dual tree each).
     pub roots: usize,
+    /// When set, a cut that leaves more crossing faces than the mesh had (every loop's cap
+    /// crossed something) is untangled at once with these options, while the mesh still has
+    /// the faces to move apart; later decimation only keeps it clean.
+    pub untangle: Option<UntangleOptions>,
 }
 
 impl Default for HandleRemovalOptions {
     fn default() -> Self {
-        HandleRemovalOptions { roots: 16 }
+        HandleRemovalOptions {
+            roots: 16,
+            untangle: None,
+        }
     }
 }
 
@@ -158,7 +168,14 @@ pub fn remove_handles(
         if current.genus() == 0 {
             break;
         }
-        let (next, handle) = remove_one_handle(&current, options)?;
+        let (mut next, handle, crosses) = remove_one_handle(&current, options)?;
+        if let Some(untangle_options) = &options.untangle
+            && crosses
+        {
+            let faces = next.n_faces();
+            untangle(&mut next, untangle_options);
+            fill_to_budget(&mut next, faces);
+        }
         current = next;
         removed.push(handle);
     }
@@ -166,11 +183,12 @@ pub fn remove_handles(
     Ok(removed)
 }
 
-/// One cut and cap on a copy of `mesh`.
+/// One cut and cap on a copy of `mesh`; true when every loop's cut crossed the surface, so the
+/// one returned (the shortest) has more crossing faces than `mesh`.
 fn remove_one_handle(
     mesh: &Mesh,
     options: &HandleRemovalOptions,
-) -> Result<(Mesh, RemovedHandle), HandleRemovalError> {
+) -> Result<(Mesh, RemovedHandle, bool), HandleRemovalError> {
     let (positions, triangles) = mesh.to_triangles();
     let compact = Mesh::from_triangles(positions.clone(), &triangles)
         .map_err(|e| HandleRemovalError::Internal(e.to_string()))?;
@@ -209,11 +227,13 @@ fn remove_one_handle(
     });
     let (first, length, loop_vertices) = cuts.next().expect("at least one loop");
     let mut chosen = (first?, length, loop_vertices);
-    if count_intersecting_faces(&chosen.0) > crossing_before {
+    let mut crosses = count_intersecting_faces(&chosen.0) > crossing_before;
+    if crosses {
         for (out, length, loop_vertices) in cuts {
             let out = out?;
             if count_intersecting_faces(&out) <= crossing_before {
                 chosen = (out, length, loop_vertices);
+                crosses = false;
                 break;
             }
         }
@@ -232,6 +252,7 @@ fn remove_one_handle(
             loop_vertices,
             loop_length: length,
         },
+        crosses,
     ))
 }
 

@@ -16,7 +16,9 @@
 //! is offered an edge collapse (kept only if it lowers the local crossing count; module
 //! `collapse`). When no pair is left, the faces that were involved are pushed apart until every
 //! non-adjacent pair of them is at least `margin_rel × bounding-box diagonal` apart, so the
-//! written file stays clean after rounding.
+//! written file stays clean after rounding. When the rounds run out, the state with the fewest
+//! crossing pairs is returned (the input at worst): on a coarse mesh the moving regions can
+//! spread a crossing they do not clear.
 //!
 //! [`limit_steps`] guards an optimizer step: it accepts the proposed vertex moves, halving a
 //! move up to `max_halvings` times and cancelling it if its faces would intersect the mesh.
@@ -99,8 +101,9 @@ pub struct UntangleStats {
 ///
 /// Promises: the mesh stays valid; only edge collapses that pass [`Mesh::can_collapse`] change
 /// the topology (genus and piece count are kept); a mesh without intersections is left
-/// bit-for-bit unchanged; at most `max_rounds` rounds run, and every face still intersecting
-/// (or within the margin of a formerly crossing face) at the end is listed in
+/// bit-for-bit unchanged; at most `max_rounds` rounds run; on failure the mesh is the state
+/// with the fewest crossing pairs the rounds reached (never more than the input's), and every
+/// face still intersecting (or within the margin of a formerly crossing face) is listed in
 /// `unresolved_faces`. Cost: one full BVH self-intersection query at the start (and after each
 /// round with collapses); then per round a BVH refit, exact tests for the faces that moved, one
 /// fast-winding-number build and two O(log F) probes per examined vertex.
@@ -116,6 +119,8 @@ pub fn untangle(mesh: &mut Mesh, options: &UntangleOptions) -> UntangleStats {
     let mut remaining: Vec<(u32, u32)> = Vec::new();
     let mut moved = false;
     let mut finder = pairs::PairFinder::default();
+    let mut best: Option<Snapshot> = None;
+    let mut last_score = (0, 0);
     for round in 0..=options.max_rounds {
         let pairs = finder.find(&buffers.positions, &buffers.triangles);
         if round == 0 {
@@ -146,6 +151,11 @@ pub fn untangle(mesh: &mut Mesh, options: &UntangleOptions) -> UntangleStats {
         } else {
             pairs.clone()
         };
+        let score = (pairs.len(), remaining.len());
+        last_score = score;
+        if best.as_ref().is_none_or(|b: &Snapshot| score < b.score) && !remaining.is_empty() {
+            best = Some(Snapshot::take(mesh, &buffers, &remaining, score));
+        }
         if remaining.is_empty() || round == options.max_rounds {
             break;
         }
@@ -183,13 +193,52 @@ pub fn untangle(mesh: &mut Mesh, options: &UntangleOptions) -> UntangleStats {
     if moved {
         write_positions(mesh, &buffers);
     }
-    let unresolved: BTreeSet<FaceId> = remaining
+    stats.unresolved_faces = unresolved_faces(&buffers, &remaining);
+    // On failure, the state with the fewest crossings (the input at worst): the rounds can
+    // spread a crossing that they do not clear.
+    if let Some(best) = best
+        && !remaining.is_empty()
+        && best.score < last_score
+    {
+        *mesh = best.mesh;
+        stats.unresolved_faces = best.unresolved_faces;
+    }
+    stats
+}
+
+/// A state of the rounds: the mesh, its crossing and margin-violating pair counts, and the
+/// faces of those pairs.
+struct Snapshot {
+    mesh: Mesh,
+    score: (usize, usize),
+    unresolved_faces: Vec<FaceId>,
+}
+
+impl Snapshot {
+    fn take(
+        mesh: &Mesh,
+        buffers: &Buffers,
+        remaining: &[(u32, u32)],
+        score: (usize, usize),
+    ) -> Self {
+        let mut copy = mesh.clone();
+        write_positions(&mut copy, buffers);
+        Snapshot {
+            mesh: copy,
+            score,
+            unresolved_faces: unresolved_faces(buffers, remaining),
+        }
+    }
+}
+
+/// The faces of the `remaining` pairs (buffer slots), as mesh ids in order.
+fn unresolved_faces(buffers: &Buffers, remaining: &[(u32, u32)]) -> Vec<FaceId> {
+    let faces: BTreeSet<FaceId> = remaining
         .iter()
         .flat_map(|&(i, j)| [i, j])
         .map(|f| buffers.face_ids[f as usize])
         .collect();
-    stats.unresolved_faces = unresolved.into_iter().collect();
-    stats
+    faces.into_iter().collect()
 }
 
 /// Copies the buffer positions of live vertices into `mesh` (only those that changed).
