@@ -138,7 +138,7 @@ fn npy_f32(shape: &[usize], values: &[f32], fortran: bool) -> Vec<u8> {
 }
 
 /// Toy settings for an SDF input at `faces`, with the SDF loss on for the second half; the Face
-/// Split block projects onto the field when `split_projector` (costly on a network: about 6
+/// Split block projects onto the field when `split_projector` (costly on a network: about 3
 /// gradient evaluations per sample of every face, every `split_interval` iterations).
 fn toy_sdf_config(faces: usize, split_projector: bool) -> ReconstructConfig {
     let iterations = 30;

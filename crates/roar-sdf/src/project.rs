@@ -26,8 +26,10 @@ impl Default for SdfProjectorOptions {
 }
 
 /// The Face Split projector of an SDF (spec §3.4 C): each sample moves along its own normal
-/// by first-order steps toward the zero set, all samples in one batch per step; a sample is
-/// invalid when `|f|` grew, its distance ended above the tolerance, or a value is not finite.
+/// by first-order steps toward the zero set, the moving samples in one batch per step, and
+/// stops as soon as its first-order distance `|f|/|∇f|` is within the tolerance (the
+/// reference takes every step; later ones would move it by less than the tolerance). A sample
+/// is invalid when `|f|` grew, its distance ended above the tolerance, or a value is not finite.
 /// Ignores the source mesh.
 pub struct SdfProjector {
     /// The field, in the coordinates of the samples.
@@ -45,35 +47,34 @@ impl Projector for SdfProjector {
         normals: &[DVec3],
     ) -> Vec<Option<DVec3>> {
         let mut x = points.to_vec();
-        let mut start = Vec::new();
+        let mut f0 = vec![f64::NAN; x.len()];
+        let mut out = vec![None; x.len()];
+        // The samples still moving; a sample stops once it is within the tolerance, where
+        // further steps would move it by less than the tolerance.
+        let mut active: Vec<usize> = (0..x.len()).collect();
         for step in 0..=self.options.steps {
-            let (values, gradients) = evaluate_with_gradients(self.sdf.as_ref(), &x);
-            if step == 0 {
-                start = values.clone();
-            }
-            if step == self.options.steps {
-                return x
-                    .iter()
-                    .zip(values.iter().zip(&gradients))
-                    .zip(&start)
-                    .map(|((p, (&f, g)), &f0)| {
-                        let distance = f.abs() / g.length();
-                        (distance.is_finite()
-                            && p.is_finite()
-                            && f.abs() <= f0.abs()
-                            && distance <= self.options.tolerance)
-                            .then_some(*p)
-                    })
-                    .collect();
-            }
-            for (((p, n), &f), g) in x.iter_mut().zip(normals).zip(&values).zip(&gradients) {
-                let d = -f * *g / g.length_squared();
-                if d.is_finite() {
-                    *p += *n * n.dot(d);
+            let at: Vec<DVec3> = active.iter().map(|&i| x[i]).collect();
+            let (values, gradients) = evaluate_with_gradients(self.sdf.as_ref(), &at);
+            let mut moving = Vec::with_capacity(active.len());
+            for ((&i, &f), g) in active.iter().zip(&values).zip(&gradients) {
+                if step == 0 {
+                    f0[i] = f;
+                }
+                let distance = f.abs() / g.length();
+                let valid = distance.is_finite() && x[i].is_finite() && f.abs() <= f0[i].abs();
+                if valid && distance <= self.options.tolerance {
+                    out[i] = Some(x[i]);
+                } else if step < self.options.steps {
+                    let d = -f * *g / g.length_squared();
+                    if d.is_finite() {
+                        x[i] += normals[i] * normals[i].dot(d);
+                    }
+                    moving.push(i);
                 }
             }
+            active = moving;
         }
-        unreachable!("the loop returns at its last step")
+        out
     }
 }
 

@@ -353,3 +353,25 @@ fn projectors_land_on_the_zero_set_of_a_scaled_field() {
         vec![None]
     );
 }
+
+#[test]
+fn the_field_projector_stops_a_sample_once_it_is_within_the_tolerance() {
+    let text = "[shape]\ntype = \"sphere\"\nradius = 0.5\nscale = 1.0\n";
+    let sphere = Arc::new(AnalyticSdf::from_toml(text).unwrap());
+    let projector = SdfProjector {
+        sdf: sphere.clone(),
+        options: SdfProjectorOptions::default(),
+    };
+    // On the sphere: kept where it is after one evaluation. Off it, radially: one step lands
+    // it (the field is a true distance), a second evaluation confirms it. Tangent: every step
+    // and a last check, then invalid.
+    let x = DVec3::X;
+    let points = [0.5 * x, 0.8 * x, 0.7 * x];
+    let normals = [x, x, DVec3::Y];
+    let projected = projector.project(&[], &[], &points, &normals);
+    assert_eq!(projected[0], Some(0.5 * x));
+    assert!((projected[1].unwrap() - 0.5 * x).length() < 1e-9);
+    assert_eq!(projected[2], None);
+    let steps = SdfProjectorOptions::default().steps as u64;
+    assert_eq!(sphere.evaluations().gradients, 1 + 2 + (steps + 1));
+}

@@ -287,8 +287,8 @@ pub struct OptimizeConfig {
     /// init of manifoldplus-chair: the collapse, split and smoothing blocks created crossings in
     /// 88, 19 and 28 of their calls, and the run fell back to its init).
     pub guard_intersections: bool,
-    /// The Face Split block of an SDF input projects its samples onto the field (§3.4 C, 6
-    /// gradient evaluations per sample) rather than by the k-NN planar projection over the point
+    /// The Face Split block of an SDF input projects its samples onto the field (§3.4 C, up to
+    /// 6 gradient evaluations per sample) rather than by the k-NN planar projection over the point
     /// cloud. The spec's choice and on by default; with a neural field it is most of the run's
     /// evaluations (`docs/sdf.md`, "Measured cost").
     pub sdf_split_projector: bool,
