@@ -3,18 +3,22 @@ of a table from `roar eval --json`. Plain python3, no packages."""
 
 import json
 import subprocess
+import tempfile
 import time
 
 
 def timed(cmd, **kwargs):
-    """Runs `cmd` under /usr/bin/time -v; returns (completed process, seconds, peak bytes)."""
-    started = time.perf_counter()
-    proc = subprocess.run(["/usr/bin/time", "-v"] + cmd, capture_output=True, text=True, **kwargs)
-    seconds = time.perf_counter() - started
-    peak = None
-    for line in proc.stderr.splitlines():
-        if "Maximum resident set size" in line:
-            peak = int(line.split(":")[1]) * 1024
+    """Runs `cmd` under /usr/bin/time -v; returns (completed process, seconds, peak bytes). The
+    process's stderr is the command's own (time writes to a file of its own)."""
+    with tempfile.NamedTemporaryFile(mode="r", suffix=".time") as report:
+        started = time.perf_counter()
+        proc = subprocess.run(["/usr/bin/time", "-v", "-o", report.name] + cmd, capture_output=True,
+                              text=True, **kwargs)
+        seconds = time.perf_counter() - started
+        peak = None
+        for line in report.read().splitlines():
+            if "Maximum resident set size" in line:
+                peak = int(line.split(":")[1]) * 1024
     return proc, seconds, peak
 
 
