@@ -1,6 +1,6 @@
 //! The loss benches' fixture, shared by `benches/loss.rs` and `examples/loss_once.rs`:
 //! `$ROAR_TEST_DATA/clean/homer.obj` (12,000 faces, closed) prepared as a run prepares a soup
-//! (cleaned target, renders of the full rig and of the faster schedule's coarse rig, point cloud), and sources made
+//! (cleaned target, renders of the full and the coarse rig, point cloud), and sources made
 //! from it: decimated by QEM and shrunk by 2 % about the rig's centre, so that both terms have
 //! work to do (silhouettes off the target's, planar moves of about 1 % of the radius).
 
@@ -16,7 +16,7 @@ use roar_render::{Camera, Image};
 /// The mesh, relative to `ROAR_TEST_DATA`.
 pub const MESH: &str = "clean/homer.obj";
 
-/// The prepared target of [`MESH`] at the default config with the coarse rig on.
+/// The prepared target of [`MESH`] at the default config.
 pub struct Homer {
     pub config: ReconstructConfig,
     pub target: Target,
@@ -34,9 +34,7 @@ impl Homer {
         let path = PathBuf::from(std::env::var_os("ROAR_TEST_DATA")?).join(MESH);
         let soup = roar_io::read_mesh(&path)
             .unwrap_or_else(|e| panic!("cannot read {}: {e}", path.display()));
-        // The coarse rig of the faster schedule (`docs/method.md`), off by default.
-        let mut config = ReconstructConfig::default();
-        config.loss.render_coarse_fraction = 1.0;
+        let config = ReconstructConfig::default();
         let target = build_target(&soup.positions, &soup.triangles, &target_options(&config))
             .expect("target of the bench mesh");
         let coarse_cameras = coarse_rig_cameras(&config);

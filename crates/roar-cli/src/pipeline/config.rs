@@ -182,7 +182,7 @@ pub struct LossConfig {
     /// term (6e-4–1.5e-3) is within 5× of the render term instead of 500× below it.
     pub planar_scale: f64,
     /// Source samples kept per planar loss evaluation (§3.2.2 cap; the default and why:
-    /// `roar_loss::planar::DEFAULT_MAX_SAMPLES`).
+    /// `roar_loss::planar::DEFAULT_MAX_SAMPLES`; 50,000 in the SDF and scan schedules).
     pub planar_max_samples: usize,
     /// Neighbours of the k-NN planar projection (§8: s2t_neighbours 10).
     pub planar_neighbours: usize,
@@ -194,9 +194,8 @@ pub struct LossConfig {
     /// `docs/method.md` says why not). Default 256.
     pub render_coarse_resolution: u32,
     /// Fraction of the loop's iterations rendered at `render_coarse_resolution`, from the
-    /// first (the finish's polish always renders at `render_resolution`). Default 0: none,
-    /// the paper's schedule; 1 with `planar_max_samples = 25000` is the faster schedule of
-    /// `docs/method.md`.
+    /// first (0: none, the paper's schedule; the finish's polish always renders at
+    /// `render_resolution`). Default 1: the whole loop; 0 in the SDF and scan schedules.
     pub render_coarse_fraction: f64,
     /// Weight of the SDF projection loss (§5: 0.1), in the objective only for inputs with a
     /// signed distance (`roar_loss::SdfLoss`).
@@ -205,6 +204,16 @@ pub struct LossConfig {
     pub sdf_loss_start: usize,
     /// `ε` of the SDF loss's projection `v − f ∇f/(|∇f|² + ε)`.
     pub sdf_loss_epsilon: f64,
+}
+
+impl LossConfig {
+    /// The paper's loss schedule: every iteration renders the full rig, the planar loss keeps
+    /// 50,000 samples. The SDF and scan schedules use it: the faster soup schedule
+    /// (`docs/method.md`) is measured on soups only.
+    fn keep_the_full_rig(&mut self) {
+        self.render_coarse_fraction = 0.0;
+        self.planar_max_samples = 50_000;
+    }
 }
 
 impl Default for LossConfig {
@@ -217,7 +226,7 @@ impl Default for LossConfig {
             planar_neighbours: 10,
             planar_t2s: true,
             render_coarse_resolution: 256,
-            render_coarse_fraction: 0.0,
+            render_coarse_fraction: 1.0,
             sdf_loss_weight: 0.1,
             sdf_loss_start: 500,
             sdf_loss_epsilon: 1e-10,
@@ -390,25 +399,28 @@ impl Default for FinishConfig {
 
 impl ReconstructConfig {
     /// The SDF schedule of spec §5, the defaults for signed distance inputs: the full pipeline
-    /// with 700 iterations and 50k faces, the SDF loss on from iteration 500.
+    /// with 700 iterations and 50k faces, the SDF loss on from iteration 500, every iteration
+    /// on the full rig.
     pub fn sdf_defaults() -> Self {
         let mut config = Self {
             faces: 50_000,
             ..Self::default()
         };
         config.optimize.iterations = 700;
+        config.loss.keep_the_full_rig();
         config
     }
 
     /// The defaults for a set of range scans: the soup's, with the init's enclosure rule at
     /// [`crate::pipeline::scans::SCAN_ENCLOSURE_WINDING_THRESHOLD`] closing every opening,
     /// however wide, since a scanned object is closed but the scanner never sees all of it (the
-    /// bunny's base).
+    /// bunny's base), and every iteration on the full rig.
     pub fn scan_defaults() -> Self {
         let mut config = Self::default();
         config.init.enclosure_winding_threshold =
             crate::pipeline::scans::SCAN_ENCLOSURE_WINDING_THRESHOLD;
         config.init.enclosure_max_cap_fraction = 1.0;
+        config.loss.keep_the_full_rig();
         config
     }
 
@@ -853,7 +865,7 @@ mod tests {
         assert_eq!(c.target.twin_ratio, 80.0);
         assert_eq!((c.loss.render_weight, c.loss.planar_weight), (3.0, 1.0));
         assert_eq!(c.loss.planar_scale, 500.0);
-        assert_eq!(c.loss.planar_max_samples, 50_000);
+        assert_eq!(c.loss.planar_max_samples, 25_000);
         assert_eq!(
             c.loss.planar_max_samples,
             roar_loss::planar::DEFAULT_MAX_SAMPLES
@@ -864,8 +876,18 @@ mod tests {
                 c.loss.render_coarse_resolution,
                 c.loss.render_coarse_fraction
             ),
-            (256, 0.0)
+            (256, 1.0)
         );
+        for other in [
+            ReconstructConfig::sdf_defaults(),
+            ReconstructConfig::scan_defaults(),
+        ] {
+            let loss = &other.loss;
+            assert_eq!(
+                (loss.render_coarse_fraction, loss.planar_max_samples),
+                (0.0, 50_000)
+            );
+        }
         assert_eq!(c.target.point_cloud_samples, 200_000);
         assert_eq!(c.target.sheet_offset, 1e-3);
         assert_eq!(c.target.sharp_edge_samples, 30_000);

@@ -563,15 +563,13 @@ mod tests {
     #[test]
     fn the_coarse_rig_is_the_rig_at_the_coarse_resolution_for_the_loops_first_iterations() {
         let mut config = ReconstructConfig::default();
-        assert!(coarse_rig_cameras(&config).is_empty(), "off by default");
-        config.loss.render_coarse_fraction = 1.0;
         let (fine, coarse) = (rig_cameras(&config), coarse_rig_cameras(&config));
         assert_eq!(coarse.len(), fine.len());
         for (c, f) in coarse.iter().zip(&fine) {
             assert_eq!((c.width, c.height), (256, 256));
             assert_eq!((c.view, c.proj), (f.view, f.proj));
         }
-        assert_eq!(coarse_until(&config), 200);
+        assert_eq!(coarse_until(&config), 200, "the whole loop by default");
         config.loss.render_coarse_fraction = 0.5;
         assert_eq!(coarse_until(&config), 100);
         // None when it would not be coarser, or would render no iteration.

@@ -27,7 +27,6 @@ pub fn toy_config(faces: usize, iterations: usize) -> ReconstructConfig {
         loss: LossConfig {
             planar_max_samples: 5000,
             render_coarse_resolution: 32,
-            render_coarse_fraction: 1.0,
             ..Default::default()
         },
         optimize: OptimizeConfig {
