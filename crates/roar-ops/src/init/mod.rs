@@ -286,8 +286,9 @@ const MAX_SPLIT_TRIANGLES: usize = 4_000_000;
 /// The same surface as `soup`, with every triangle cut at the midpoint of its longest edge until no
 /// edge is longer than `max_edge`. Closest points are unchanged, but a BVH over the pieces has
 /// small boxes, so a query opens few faces even when the soup has huge triangles (a few big
-/// triangles overlapping every box made queries test almost every face).
-fn split_long_edges(soup: &[[DVec3; 3]], max_edge: f64) -> (Vec<DVec3>, Vec<[u32; 3]>) {
+/// triangles overlapping every box made queries test almost every face), and the same holds for
+/// the fast winding number's tree (`winding_solid`).
+pub(crate) fn split_long_edges(soup: &[[DVec3; 3]], max_edge: f64) -> (Vec<DVec3>, Vec<[u32; 3]>) {
     let mut out: Vec<[DVec3; 3]> = Vec::with_capacity(soup.len());
     let mut stack: Vec<[DVec3; 3]> = Vec::new();
     let limit2 = max_edge * max_edge;

@@ -79,11 +79,11 @@ pub(crate) fn fill_enclosed(
     max_cap_fraction: f64,
     views: &[ScannerView],
 ) -> EnclosedFill {
-    let oriented = split_long_triangles(&first_of_each_twin_pair(soup), 4.0 * grid.voxel_size);
-    let positions: Vec<DVec3> = oriented.iter().flatten().copied().collect();
-    let triangles: Vec<[u32; 3]> = (0..oriented.len() as u32)
-        .map(|f| [3 * f, 3 * f + 1, 3 * f + 2])
-        .collect();
+    // Long triangles bisected: the winding number is the same (solid angles add up), but a long
+    // triangle sits in a wide leaf of the fast winding number's tree, which every query near it
+    // must evaluate exactly, while short ones are summed by the far-field expansion.
+    let (positions, triangles) =
+        super::split_long_edges(&first_of_each_twin_pair(soup), 4.0 * grid.voxel_size);
     let Ok(winding) = WindingNumber::build(&positions, &triangles) else {
         // Unreachable: the indices above are in range by construction.
         return EnclosedFill::default();
@@ -242,32 +242,6 @@ fn first_of_each_twin_pair(soup: &[[DVec3; 3]]) -> Vec<[DVec3; 3]> {
         .collect()
 }
 
-/// `soup` with every triangle whose longest edge exceeds `max_edge` bisected at that edge's
-/// midpoint until none does. Solid angles add up, so the winding number is the same; but a
-/// long triangle sits in a wide leaf of the fast winding number's tree, which every query
-/// near it must evaluate exactly, while short ones are summed by the far-field expansion.
-fn split_long_triangles(soup: &[[DVec3; 3]], max_edge: f64) -> Vec<[DVec3; 3]> {
-    let mut out = Vec::with_capacity(soup.len());
-    let mut stack: Vec<[DVec3; 3]> = Vec::new();
-    for &t in soup {
-        stack.push(t);
-        while let Some(t) = stack.pop() {
-            let lengths = [0, 1, 2].map(|i| t[i].distance(t[(i + 1) % 3]));
-            let i = (0..3).fold(0, |a, b| if lengths[b] > lengths[a] { b } else { a });
-            // A NaN length stops too: nothing to bisect.
-            if lengths[i] <= max_edge || lengths[i].is_nan() {
-                out.push(t);
-                continue;
-            }
-            let (a, b, c) = (t[i], t[(i + 1) % 3], t[(i + 2) % 3]);
-            let m = 0.5 * (a + b);
-            stack.push([a, m, c]);
-            stack.push([m, b, c]);
-        }
-    }
-    out
-}
-
 fn bounds(points: &[DVec3]) -> (DVec3, DVec3) {
     points.iter().fold(
         (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)),
@@ -382,29 +356,14 @@ mod tests {
     }
 
     #[test]
-    fn long_triangles_split_into_short_ones_with_the_same_winding_number() {
+    fn splitting_long_edges_keeps_the_winding_number() {
         let soup = box_soup(DVec3::ZERO, DVec3::new(4.0, 1.0, 0.5), true);
-        let split = split_long_triangles(&soup, 0.3);
-        let area = |s: &[[DVec3; 3]]| -> f64 {
-            s.iter()
-                .map(|t| 0.5 * (t[1] - t[0]).cross(t[2] - t[0]).length())
-                .sum()
-        };
-        assert!(split.len() > 10 * soup.len());
-        assert!((area(&split) - area(&soup)).abs() < 1e-9 * area(&soup));
-        for t in &split {
-            for i in 0..3 {
-                assert!(t[i].distance(t[(i + 1) % 3]) <= 0.3);
-            }
-        }
-        let indexed = |s: &[[DVec3; 3]]| {
-            let positions: Vec<DVec3> = s.iter().flatten().copied().collect();
-            let triangles: Vec<[u32; 3]> = (0..s.len() as u32)
-                .map(|f| [3 * f, 3 * f + 1, 3 * f + 2])
-                .collect();
-            (positions, triangles)
-        };
-        let ((p0, t0), (p1, t1)) = (indexed(&soup), indexed(&split));
+        let (p1, t1) = super::super::split_long_edges(&soup, 0.3);
+        assert!(t1.len() > 10 * soup.len());
+        let p0: Vec<DVec3> = soup.iter().flatten().copied().collect();
+        let t0: Vec<[u32; 3]> = (0..soup.len() as u32)
+            .map(|f| [3 * f, 3 * f + 1, 3 * f + 2])
+            .collect();
         for q in [
             DVec3::new(2.0, 0.5, 0.25),
             DVec3::new(0.1, 0.9, 0.6),
