@@ -171,11 +171,11 @@ fn finish_budgets(faces: usize, budget: usize, polishing: bool) -> Vec<usize> {
 }
 
 /// The guaranteed QEM to exactly `faces` (best effort only if configured). Unless
-/// `keep_topology`, handles are removed (shortest loop first, `roar_ops::finish::genus`) when the genus
-/// needs more faces than `faces` or the QEM stalls above it, the crossings of each cut untangled
-/// at once and again at the end; when some stay, the whole step is retried with more handles
-/// removed first. Each
-/// removal is noted on stderr and recorded in `stats.handles_removed`.
+/// `keep_topology`, handles are removed (shortest loop first, `roar_ops::finish::genus`) when
+/// the genus needs more faces than `faces` or the QEM stalls above it, the crossings of each
+/// cut untangled at once and again at the end; when some stay, the whole step is retried with
+/// more handles removed first. Each removal is noted on stderr and recorded in
+/// `stats.handles_removed`.
 fn final_decimation(
     mesh: &mut Mesh,
     faces: usize,
