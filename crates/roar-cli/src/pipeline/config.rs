@@ -364,6 +364,15 @@ pub struct FinishConfig {
     /// the kept mesh intersects itself, the QEM output is kept (the report says so). Runs only when
     /// `iterations > 0`, so `--iterations 0` stays the plain init + QEM.
     pub polish_iterations: usize,
+    /// For an input with a signed distance (an SDF), after the polish: this many steps (default
+    /// 3; 0 = off) that move every vertex along its normal by minus the mean first-order distance
+    /// `f/|∇f|` over its faces (sampled at their edge midpoints), except where the move is long
+    /// against its faces, would turn a face over or make faces intersect
+    /// (`roar_ops::finish::zero_set`). [INF] Not in the paper: the loop's mesh is on
+    /// the surface only as far as the losses pull it, and the fill splits to a large budget put
+    /// their vertices on chords (`docs/sdf.md`, "Measured cost"). Soups have no field and skip
+    /// it. Runs only when `iterations > 0`.
+    pub zero_set_steps: usize,
     /// Last step: flip the edges of faces with aspect ratio `Q = R/(2r)` above this when both faces
     /// of the edge get better, the two are nearly coplanar (0.95; against the other face alone when
     /// one is degenerate, above 100) and no intersection appears (`roar_ops::finish::slivers`;
@@ -390,6 +399,7 @@ impl Default for FinishConfig {
             final_smoothing_sweeps: 3,
             data_flip_rounds: 5,
             polish_iterations: 20,
+            zero_set_steps: 3,
             sliver_quality: 10.0,
             best_effort: false,
             keep_topology: false,
@@ -625,6 +635,10 @@ impl ReconstructConfig {
             (
                 r("finish.polish_iterations", 0.0, 1e5),
                 self.finish.polish_iterations as f64,
+            ),
+            (
+                r("finish.zero_set_steps", 0.0, 100.0),
+                self.finish.zero_set_steps as f64,
             ),
             (
                 off("finish.sliver_quality", 1.0, 1e6),

@@ -1,6 +1,7 @@
 //! The finish stage: the lowest-loss loop state the untangle block clears, filled to N; the
 //! final QEMs (to 2N and polish first when the mesh is larger), each followed by smoothing,
-//! data flips and the polish; then sliver flips. Every step after the QEMs goes through
+//! data flips and the polish; for an SDF input the fit to the field's zero set; then
+//! sliver flips. Every step after the QEMs goes through
 //! [`keep_if_clean`]: it is kept only if the mesh stays free of self-intersections in the
 //! input's coordinates, where it will be written.
 
@@ -9,7 +10,7 @@ use std::convert::Infallible;
 use glam::DVec3;
 use roar_loss::{KnnPlanarProjector, Loss};
 use roar_mesh::Mesh;
-use roar_mesh::spatial::{Normalization, self_intersecting_faces};
+use roar_mesh::spatial::{Normalization, Sdf, self_intersecting_faces};
 use roar_ops::blocks::smoothing::SmoothingOptions;
 use roar_ops::decimate::{DecimateOptions, DecimateStats, decimate};
 use roar_ops::finish::data_flips::{DataFlipOptions, flip_toward_target};
@@ -18,17 +19,20 @@ use roar_ops::finish::fill::fill_to_budget;
 use roar_ops::finish::genus::{HandleRemovalOptions, decimate_removing_handles, remove_handles};
 use roar_ops::finish::offset::offset_outward;
 use roar_ops::finish::slivers::{SliverOptions, flip_slivers};
+use roar_ops::finish::zero_set::{ZeroSetOptions, fit_to_zero_set};
 use roar_ops::untangle::{UntangleOptions, UntangleStats, untangle};
 
 use super::optimize::{LoopState, move_vertices, new_optimizer};
 use super::{PipelineError, ReconstructConfig, Run, RunStats, StageClock, UntangleFailure};
 
-/// Finishes from the loop's `states` with `loss` (dropped before the sliver flips) and the
-/// cloud's `projector` (for the data flips); returns the final mesh in rig coordinates.
+/// Finishes from the loop's `states` with `loss` (dropped before the sliver flips), the
+/// cloud's `projector` (for the data flips) and the shape's `field`, if it has one; returns the
+/// final mesh in rig coordinates.
 pub(super) fn finish(
     states: Vec<LoopState>,
     mut loss: Box<dyn Loss>,
     projector: &KnnPlanarProjector,
+    field: Option<&dyn Sdf>,
     normalization: &Normalization,
     run: &mut Run,
 ) -> Result<Mesh, PipelineError> {
@@ -91,6 +95,13 @@ pub(super) fn finish(
         }
     }
     drop(loss);
+    if let Some(field) = field
+        && config.optimize.iterations > 0
+        && config.finish.zero_set_steps > 0
+    {
+        mesh = fit_to_zero_set_if_clean(mesh, field, normalization, config, &mut run.stats);
+        run.clock.lap("zero_set");
+    }
     if config.optimize.iterations > 0 && config.finish.sliver_quality > 0.0 {
         mesh = remove_slivers_if_clean(mesh, normalization, config, &mut run.stats);
         run.clock.lap("sliver_flips");
@@ -318,6 +329,31 @@ fn flip_toward_cloud_if_clean(
         flip_toward_target(flipped, &target_normal, &options).accepted
     });
     stats.finish.data_flips += flips;
+    mesh
+}
+
+/// The mesh fitted to `field`'s zero set (`roar_ops::finish::zero_set`), kept only if the
+/// result is free of self-intersections in the input's coordinates, as for the smoothing.
+fn fit_to_zero_set_if_clean(
+    mesh: Mesh,
+    field: &dyn Sdf,
+    normalization: &Normalization,
+    config: &ReconstructConfig,
+    stats: &mut RunStats,
+) -> Mesh {
+    let options = ZeroSetOptions {
+        steps: config.finish.zero_set_steps,
+        epsilon: config.loss.sdf_loss_epsilon,
+        ..ZeroSetOptions::default()
+    };
+    let mut held = 0;
+    let (mesh, fitted) = keep_if_clean(mesh, normalization, |moved| {
+        let fit = fit_to_zero_set(moved, field, &options);
+        held = fit.held;
+        fit.fitted
+    });
+    stats.finish.zero_set_fitted = fitted;
+    stats.finish.zero_set_held = if fitted > 0 { held } else { 0 };
     mesh
 }
 

@@ -236,6 +236,13 @@ pub struct FinishStats {
     /// Whether the last polished mesh was kept (false: it intersected itself, or no polish ran;
     /// true also when its best state was the unpolished one).
     pub polish_kept: bool,
+    /// Vertices the fit to the field's zero set moved the whole way (`zero_set_steps`; SDF
+    /// inputs only; 0 also when the moved mesh was dropped because it would have intersected
+    /// itself).
+    pub zero_set_fitted: usize,
+    /// Vertices that step held back, wholly or in part (a long move, a face turned over, an
+    /// intersection).
+    pub zero_set_held: usize,
     /// Sliver flips in the output (`sliver_quality`; 0 also when they were undone because the
     /// written mesh would have intersected itself).
     pub sliver_flips: usize,
@@ -344,6 +351,7 @@ impl Reconstruction {
             states,
             loss,
             &objective.projector,
+            shape.signed_distance().as_deref(),
             &target.normalization,
             &mut run,
         )?;

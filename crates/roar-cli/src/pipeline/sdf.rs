@@ -31,8 +31,8 @@ pub const DEFAULT_BOUNDS: Aabb = roar_sdf::DEFAULT_BOUNDS;
 #[derive(Clone, Debug, Default, Serialize)]
 pub struct SdfReport {
     /// Points evaluated for values, by stage: `trace` (the target renders), `init` (the voxel
-    /// init), `point_cloud`, `loop` (the SDF loss and the Face Split projector), and `preview`
-    /// (the `--preview` picture's input views, when asked for).
+    /// init), `point_cloud`, `loop` (the SDF loss, the Face Split projector and the finish's fit
+    /// to the zero set), and `preview` (the `--preview` picture's input views, when asked for).
     pub values: BTreeMap<&'static str, u64>,
     /// Points evaluated for values and gradients, by the same stages.
     pub gradients: BTreeMap<&'static str, u64>,
