@@ -12,7 +12,12 @@ from roar_runs import evaluate, timed
 
 
 def extract(roar, field, mesh, resolution, bounds):
-    """`roar extract`; returns its JSON line plus seconds and peak bytes."""
+    """`roar extract`; returns its JSON line plus seconds and peak bytes, kept in MESH.json so that
+    the reference's extraction serves as its resolution's row and a rerun resumes."""
+    info_path = mesh + ".json"
+    if os.path.exists(mesh) and os.path.exists(info_path):
+        with open(info_path) as f:
+            return json.load(f)
     cmd = [roar, "extract", field, "-o", mesh, "--resolution", str(resolution)]
     if bounds:
         cmd += ["--bounds", bounds]
@@ -21,6 +26,8 @@ def extract(roar, field, mesh, resolution, bounds):
         sys.exit("extract failed: " + proc.stderr.strip().splitlines()[-1])
     line = json.loads(proc.stdout.strip().splitlines()[-1])
     line.update(seconds=seconds, peak_bytes=peak)
+    with open(info_path, "w") as f:
+        json.dump(line, f)
     return line
 
 
@@ -33,12 +40,13 @@ def main():
     p.add_argument("--reference", type=int, required=True)
     p.add_argument("--config", default="")
     p.add_argument("--bounds", default="")
+    p.add_argument("--samples", type=int, required=True)
     p.add_argument("--out", required=True)
     a = p.parse_args()
     rows = []
     for field in a.fields:
         name = os.path.basename(field).split(".")[0]
-        ref = os.path.join(a.out, "%s-reference-%d.obj" % (name, a.reference))
+        ref = os.path.join(a.out, "%s-mt-%d.obj" % (name, a.reference))
         if not os.path.exists(ref):
             info = extract(a.roar, field, ref, a.reference, a.bounds)
             print("%s: reference %d³ %.0f s, %d faces" % (name, a.reference, info["seconds"], info["faces"]),
@@ -71,7 +79,7 @@ def main():
                     sdf = json.load(f)["sdf"]
                 row["values"] = sum(sdf["values"].values())
                 row["gradients"] = sum(sdf["gradients"].values())
-                row.update(evaluate(a.roar, mesh, ref))
+                row.update(evaluate(a.roar, mesh, ref, a.samples))
             print(row, file=sys.stderr)
             rows.append(row)
         for r in a.resolutions:
@@ -90,7 +98,7 @@ def main():
                     if proc.returncode != 0:
                         row["error"] = proc.stderr.strip().splitlines()[-1]
                     else:
-                        row.update(evaluate(a.roar, mesh, ref))
+                        row.update(evaluate(a.roar, mesh, ref, a.samples))
                 print(row, file=sys.stderr)
                 rows.append(row)
     with open(os.path.join(a.out, "results.json"), "w") as f:

@@ -22,9 +22,12 @@ def timed(cmd, **kwargs):
     return proc, seconds, peak
 
 
-def evaluate(roar, mesh, ref):
-    """The figures of the table from `roar eval MESH --ref REF --json`."""
-    proc = subprocess.run([roar, "eval", mesh, "--ref", ref, "--json"], capture_output=True, text=True)
+def evaluate(roar, mesh, ref, samples=None):
+    """The figures of the table from `roar eval MESH --ref REF --json [--samples SAMPLES]`."""
+    cmd = [roar, "eval", mesh, "--ref", ref, "--json"]
+    if samples:
+        cmd += ["--samples", str(samples)]
+    proc = subprocess.run(cmd, capture_output=True, text=True)
     if proc.returncode != 0:
         return {"error": proc.stderr.strip()}
     r = json.loads(proc.stdout)
