@@ -47,8 +47,9 @@ pub struct ZeroSetStats {
 /// face's mean taken at its edge midpoints, the quadrature exact for a distance quadratic over
 /// the face). Then each vertex's move is shortened to `max_move_fraction` of its smallest height,
 /// moves that would make faces intersect are shortened or cancelled (`limit_steps`) and moves
-/// that turn a face over (its normal against the old one) are undone. The topology stays; the
-/// mesh stays free of self-intersections when it was.
+/// that turn a face over (its normal against the old one) are undone. The topology stays. An
+/// undone move can, rarely, meet a shortened one, so a caller that needs the mesh free of
+/// self-intersections checks the result (the finish keeps it only if it is clean).
 ///
 /// Why: the loop's mesh sits on the surface only as far as the render, planar and SDF losses
 /// pull it, and the fill splits that bring it to a large budget put their new vertices on the
@@ -191,8 +192,8 @@ fn smallest_heights(positions: &[DVec3], triangles: &[[u32; 3]]) -> Vec<f64> {
 }
 
 /// Puts back the corners of every face whose normal turned by more than 90° until none does
-/// (each round puts back at least one vertex, so it ends). Putting back can only make the limited
-/// moves shorter, which keeps them free of intersections with each other.
+/// (each round puts back at least one vertex, so it ends). The positions it leaves were not
+/// among those the step limiter checked, so they are not certain to be free of intersections.
 fn undo_turned_faces(before: &[DVec3], moved: &mut [DVec3], triangles: &[[u32; 3]]) {
     loop {
         let mut undone = 0;
