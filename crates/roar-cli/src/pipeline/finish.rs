@@ -19,7 +19,7 @@ use roar_ops::finish::fill::fill_to_budget;
 use roar_ops::finish::genus::{HandleRemovalOptions, decimate_removing_handles, remove_handles};
 use roar_ops::finish::offset::offset_outward;
 use roar_ops::finish::slivers::{SliverOptions, flip_slivers};
-use roar_ops::finish::zero_set::{ZeroSetOptions, fit_to_zero_set};
+use roar_ops::finish::zero_set::{ZeroSetOptions, ZeroSetStats, fit_to_zero_set};
 use roar_ops::untangle::{UntangleOptions, UntangleStats, untangle};
 
 use super::optimize::{LoopState, move_vertices, new_optimizer};
@@ -346,14 +346,15 @@ fn fit_to_zero_set_if_clean(
         epsilon: config.loss.sdf_loss_epsilon,
         ..ZeroSetOptions::default()
     };
-    let mut held = 0;
-    let (mesh, fitted) = keep_if_clean(mesh, normalization, |moved| {
-        let fit = fit_to_zero_set(moved, field, &options);
-        held = fit.held;
-        fit.fitted
+    let mut fit = ZeroSetStats::default();
+    let (mesh, moved) = keep_if_clean(mesh, normalization, |moved| {
+        fit = fit_to_zero_set(moved, field, &options);
+        fit.fitted + fit.shortened
     });
-    stats.finish.zero_set_fitted = fitted;
-    stats.finish.zero_set_held = if fitted > 0 { held } else { 0 };
+    if moved > 0 {
+        stats.finish.zero_set_fitted = fit.fitted;
+        stats.finish.zero_set_held = fit.shortened + fit.unmoved;
+    }
     mesh
 }
 

@@ -1,8 +1,6 @@
 //! The last step of an SDF input's finish: the mesh fitted to the field's zero set, every vertex
 //! moved along its normal as far as it can go without folding or crossing a face.
 
-use std::collections::HashMap;
-
 use glam::DVec3;
 use roar_mesh::Mesh;
 use roar_mesh::spatial::{Sdf, area_weighted_vertex_normals, triangle_normal};
@@ -37,9 +35,12 @@ impl Default for ZeroSetOptions {
 pub struct ZeroSetStats {
     /// Vertices moved the whole fitted way.
     pub fitted: usize,
-    /// Vertices that kept their place or moved part of the way: a move too long for their
-    /// faces, a face it would turn over, or an intersection it would make.
-    pub held: usize,
+    /// Vertices moved part of the way: a move too long for their faces, or one that would make
+    /// faces intersect.
+    pub shortened: usize,
+    /// Vertices left where they were: a move that would turn a face over or make faces
+    /// intersect however short, or none to make.
+    pub unmoved: usize,
 }
 
 /// Fits `mesh` to the zero set of `sdf`: `options.steps` times, every vertex moves along its
@@ -47,9 +48,9 @@ pub struct ZeroSetStats {
 /// face's mean taken at its edge midpoints, the quadrature exact for a distance quadratic over
 /// the face). Then each vertex's move is shortened to `max_move_fraction` of its smallest height,
 /// moves that would make faces intersect are shortened or cancelled (`limit_steps`) and moves
-/// that turn a face over (its normal against the old one) are undone. The topology stays. An
-/// undone move can, rarely, meet a shortened one, so a caller that needs the mesh free of
-/// self-intersections checks the result (the finish keeps it only if it is clean).
+/// that turn a face over (its normal against the old one) are undone, the limiter checking the
+/// positions again after each undoing. The topology stays; the mesh stays free of
+/// self-intersections when it was.
 ///
 /// Why: the loop's mesh sits on the surface only as far as the render, planar and SDF losses
 /// pull it, and the fill splits that bring it to a large budget put their new vertices on the
@@ -57,13 +58,13 @@ pub struct ZeroSetStats {
 /// vertex: vertices on the zero set would put the faces of a curved part inside it (the chords
 /// of a sphere), which at 5,000 faces costs more than it gains.
 pub fn fit_to_zero_set(mesh: &mut Mesh, sdf: &dyn Sdf, options: &ZeroSetOptions) -> ZeroSetStats {
-    // Compact, the mesh's vertex ids are the indices of `to_triangles`.
+    // Compact, the mesh's vertex, edge and face ids are dense, and the vertex ids are the
+    // indices of `to_triangles`.
     mesh.compact();
     let (positions, triangles) = mesh.to_triangles();
-    let edges = FaceEdges::new(&triangles);
     let mut fitted = positions.clone();
     for _ in 0..options.steps {
-        let offsets = mean_distances(&fitted, &triangles, &edges, sdf, options.epsilon);
+        let offsets = mean_distances(mesh, &fitted, sdf, options.epsilon);
         let normals = area_weighted_vertex_normals(&fitted, &triangles);
         for ((p, n), d) in fitted.iter_mut().zip(&normals).zip(&offsets) {
             *p -= *n * *d;
@@ -71,8 +72,8 @@ pub fn fit_to_zero_set(mesh: &mut Mesh, sdf: &dyn Sdf, options: &ZeroSetOptions)
     }
 
     let heights = smallest_heights(&positions, &triangles);
-    let mut moved = fitted.clone();
-    for ((target, &old), &height) in moved.iter_mut().zip(&positions).zip(&heights) {
+    let mut targets = fitted.clone();
+    for ((target, &old), &height) in targets.iter_mut().zip(&positions).zip(&heights) {
         let length = (*target - old).length();
         let longest = options.max_move_fraction * height;
         if !length.is_finite() {
@@ -81,64 +82,42 @@ pub fn fit_to_zero_set(mesh: &mut Mesh, sdf: &dyn Sdf, options: &ZeroSetOptions)
             *target = old + (*target - old) * (longest / length);
         }
     }
-    limit_steps(
-        &positions,
-        &mut moved,
-        &triangles,
-        &LimiterOptions::default(),
-    );
-    undo_turned_faces(&positions, &mut moved, &triangles);
+    // Each round that undoes a move leaves one more vertex where it was (the limiter never
+    // moves a vertex past its target), so the loop ends.
+    let moved = loop {
+        let mut moved = targets.clone();
+        limit_steps(
+            &positions,
+            &mut moved,
+            &triangles,
+            &LimiterOptions::default(),
+        );
+        if !undo_turned_faces(&positions, &mut moved, &triangles) {
+            break moved;
+        }
+        targets = moved;
+    };
 
     let fitted = moved.iter().zip(&fitted).filter(|(a, b)| a == b).count();
+    let unmoved = moved.iter().zip(&positions).filter(|(a, b)| a == b).count();
     mesh.positions_mut().copy_from_slice(&moved);
     ZeroSetStats {
         fitted,
-        held: positions.len() - fitted,
+        shortened: positions.len() - fitted - unmoved,
+        unmoved,
     }
 }
 
-/// The edges of a triangle list, each once, and each face's three edges.
-struct FaceEdges {
-    /// Vertex pairs, lower index first.
-    edges: Vec<[u32; 2]>,
-    /// Per face, the indices into `edges` of its three edges.
-    faces: Vec<[usize; 3]>,
-}
-
-impl FaceEdges {
-    fn new(triangles: &[[u32; 3]]) -> Self {
-        let mut index = HashMap::with_capacity(triangles.len() * 3 / 2);
-        let mut edges = Vec::with_capacity(triangles.len() * 3 / 2);
-        let faces = triangles
-            .iter()
-            .map(|t| {
-                [0, 1, 2].map(|k| {
-                    let (a, b) = (t[k], t[(k + 1) % 3]);
-                    let key = [a.min(b), a.max(b)];
-                    *index.entry(key).or_insert_with(|| {
-                        edges.push(key);
-                        edges.len() - 1
-                    })
-                })
-            })
-            .collect();
-        Self { edges, faces }
-    }
-}
-
-/// Per vertex, the area-weighted mean over its faces of the first-order distance `f/|∇f|`
-/// averaged at each face's edge midpoints (0 for a vertex in no face).
-fn mean_distances(
-    positions: &[DVec3],
-    triangles: &[[u32; 3]],
-    edges: &FaceEdges,
-    sdf: &dyn Sdf,
-    epsilon: f64,
-) -> Vec<f64> {
-    let midpoints: Vec<DVec3> = edges
-        .edges
-        .iter()
-        .map(|&[a, b]| 0.5 * (positions[a as usize] + positions[b as usize]))
+/// Per vertex of the compact `mesh` at `positions`, the area-weighted mean over its faces of
+/// the first-order distance `f/|∇f|` averaged at each face's edge midpoints (0 for a vertex in
+/// no face).
+fn mean_distances(mesh: &Mesh, positions: &[DVec3], sdf: &dyn Sdf, epsilon: f64) -> Vec<f64> {
+    let midpoints: Vec<DVec3> = mesh
+        .edges()
+        .map(|e| {
+            let [a, b] = mesh.edge_vertices(e);
+            0.5 * (positions[a.index()] + positions[b.index()])
+        })
         .collect();
     let mut values = vec![0.0; midpoints.len()];
     let mut gradients = vec![DVec3::ZERO; midpoints.len()];
@@ -149,12 +128,18 @@ fn mean_distances(
         .map(|(&f, g)| f / (g.length() + epsilon))
         .collect();
     let mut sums = vec![(0.0, 0.0); positions.len()];
-    for (t, face_edges) in triangles.iter().zip(&edges.faces) {
-        let p = t.map(|i| positions[i as usize]);
+    for f in mesh.faces() {
+        let corners = mesh.face_vertices(f);
+        let p = corners.map(|v| positions[v.index()]);
         let area = (p[1] - p[0]).cross(p[2] - p[0]).length();
-        let distance = face_edges.iter().map(|&e| distances[e]).sum::<f64>() / 3.0;
-        for &v in t {
-            let (weighted, weight) = &mut sums[v as usize];
+        let distance = mesh
+            .face_halfedges(f)
+            .iter()
+            .map(|&h| distances[mesh.edge(h).index()])
+            .sum::<f64>()
+            / 3.0;
+        for v in corners {
+            let (weighted, weight) = &mut sums[v.index()];
             *weighted += area * distance;
             *weight += area;
         }
@@ -192,9 +177,9 @@ fn smallest_heights(positions: &[DVec3], triangles: &[[u32; 3]]) -> Vec<f64> {
 }
 
 /// Puts back the corners of every face whose normal turned by more than 90° until none does
-/// (each round puts back at least one vertex, so it ends). The positions it leaves were not
-/// among those the step limiter checked, so they are not certain to be free of intersections.
-fn undo_turned_faces(before: &[DVec3], moved: &mut [DVec3], triangles: &[[u32; 3]]) {
+/// (each round puts back at least one vertex, so it ends); returns whether it put any back.
+fn undo_turned_faces(before: &[DVec3], moved: &mut [DVec3], triangles: &[[u32; 3]]) -> bool {
+    let mut any = false;
     loop {
         let mut undone = 0;
         for t in triangles {
@@ -211,8 +196,9 @@ fn undo_turned_faces(before: &[DVec3], moved: &mut [DVec3], triangles: &[[u32; 3
             }
         }
         if undone == 0 {
-            return;
+            return any;
         }
+        any = true;
     }
 }
 
@@ -233,14 +219,11 @@ mod tests {
         }
         let sphere = FnSdf::new(|p: DVec3| p.length() - 1.0);
         let stats = fit_to_zero_set(&mut mesh, &sphere, &ZeroSetOptions::default());
-        assert_eq!(stats.held, 0);
         assert_eq!(stats.fitted, mesh.n_vertices());
-        let (positions, triangles) = mesh.to_triangles();
-        for p in &positions {
+        for p in mesh.positions() {
             assert!(p.length() > 1.0 && p.length() < 1.005, "{}", p.length());
         }
-        let edges = FaceEdges::new(&triangles);
-        let left = mean_distances(&positions, &triangles, &edges, &sphere, 1e-10);
+        let left = mean_distances(&mesh, mesh.positions(), &sphere, 1e-10);
         for d in left {
             assert!(d.abs() < 1e-4, "{d}");
         }
@@ -259,8 +242,7 @@ mod tests {
         let heights = smallest_heights(&before, &triangles);
         let sphere = FnSdf::new(|p: DVec3| p.length() - 1.0);
         let stats = fit_to_zero_set(&mut mesh, &sphere, &ZeroSetOptions::default());
-        assert_eq!(stats.fitted, 0);
-        assert_eq!(stats.held, mesh.n_vertices());
+        assert_eq!(stats.shortened, mesh.n_vertices());
         for ((p, old), height) in mesh.positions().iter().zip(&before).zip(&heights) {
             assert!(p.length() > old.length());
             let moved = (*p - *old).length();
@@ -287,7 +269,7 @@ mod tests {
         let sphere = FnSdf::new(|p: DVec3| p.length() - 0.98);
         let before = mesh.clone();
         let stats = fit_to_zero_set(&mut mesh, &sphere, &ZeroSetOptions::default());
-        assert!(stats.held > 0, "{stats:?}");
+        assert!(stats.shortened + stats.unmoved > 0, "{stats:?}");
         let (positions, triangles) = mesh.to_triangles();
         assert!(!self_intersecting_faces(&positions, &triangles).contains(&true));
         let (old, _) = before.to_triangles();
