@@ -39,8 +39,10 @@ fn run_with(
     for stage in ["target", "init", "optimize", "decimate"] {
         assert!(stages.contains(&stage), "progress never reported {stage}");
     }
-    // The report's history has one record per iteration whose terms add up to the loss.
-    assert_eq!(out.stats.optimize.history.len(), config_iterations);
+    // The report's history has one record per iteration run whose terms add up to the loss.
+    let ran = out.stats.optimize.loop_iterations;
+    assert!(ran <= config_iterations);
+    assert_eq!(out.stats.optimize.history.len(), ran);
     for record in &out.stats.optimize.history {
         let names: Vec<&str> = record.terms.keys().copied().collect();
         assert_eq!(names, ["planar", "render"]);
@@ -126,6 +128,36 @@ fn a_tangle_made_in_the_loop_is_never_the_state_the_run_finishes_from() {
     mesh.validate().unwrap();
     assert!(mesh.signed_volume() > 0.0);
     assert!(!self_intersecting_faces(&positions, &triangles).contains(&true));
+}
+
+#[test]
+fn the_loop_stops_once_its_loss_has_levelled_off() {
+    let config = |level_window| {
+        let mut config = toy_config(300);
+        config.optimize.iterations = 20;
+        config.optimize.checkpoint_interval = 2;
+        config.optimize.level_window = level_window;
+        config
+    };
+    // Scrambled at iteration 4: no later state comes near the loss before it, so the window of
+    // 4 iterations after that brings nothing and the loop stops at the checkpoint of iteration
+    // 8 (or earlier, had the toy's loss levelled off before the scramble).
+    let scramble = || ScheduledBlock {
+        block: Box::new(Scramble { at_iteration: 4 }),
+        every: 1,
+        skip_first: false,
+    };
+    let (_, triangles, stats) = run_with(config(4), vec![scramble()]);
+    assert!(
+        stats.optimize.loop_iterations <= 9,
+        "{}",
+        stats.optimize.loop_iterations
+    );
+    assert!(stats.optimize.finished_from_iteration <= 4);
+    assert_eq!(triangles.len(), 300);
+    // Without the window it runs every iteration.
+    let (_, _, stats) = run_with(config(0), vec![scramble()]);
+    assert_eq!(stats.optimize.loop_iterations, 20);
 }
 
 #[test]

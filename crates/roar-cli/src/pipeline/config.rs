@@ -283,6 +283,15 @@ pub struct OptimizeConfig {
     /// faces) it can drift up (libigl-camelhead: 0.0486 at iteration 50, 0.0535 at 199); and the
     /// last state may be a tangle the untangle cannot clear.
     pub checkpoint_interval: usize,
+    /// Stop the loop once its loss has levelled off: at a checkpoint, when no checkpoint of the
+    /// last `level_window` iterations has a loss `level_tolerance` (relative) below the lowest
+    /// one before them (0 = always run `iterations`; needs `checkpoint_interval > 0`).
+    /// Defaults 50 and 0.01; off in the SDF schedule, whose SDF loss starts at iteration 500.
+    /// [INF] Not in the paper: the run finishes from the lowest-loss checkpoint, and on the wild
+    /// meshes the loss levels off by iteration 50–100 (`docs/method.md`, "When the loop stops").
+    pub level_window: usize,
+    /// See `level_window`.
+    pub level_tolerance: f64,
     /// Shorten optimizer steps that would make faces intersect (`roar_ops::untangle::limit_steps`),
     /// so the loop itself keeps the mesh intersection-free where the blocks did.
     pub step_limiter: bool,
@@ -319,6 +328,8 @@ impl Default for OptimizeConfig {
             split_threshold: 0.02,
             smoothing_interval: 0,
             checkpoint_interval: 10,
+            level_window: 50,
+            level_tolerance: 0.01,
             step_limiter: true,
             guard_intersections: false,
             sdf_split_projector: true,
@@ -410,13 +421,14 @@ impl Default for FinishConfig {
 impl ReconstructConfig {
     /// The SDF schedule of spec §5, the defaults for signed distance inputs: the full pipeline
     /// with 700 iterations and 50k faces, the SDF loss on from iteration 500, every iteration
-    /// on the full rig.
+    /// on the full rig and run (no stop when the loss levels off before the SDF loss starts).
     pub fn sdf_defaults() -> Self {
         let mut config = Self {
             faces: 50_000,
             ..Self::default()
         };
         config.optimize.iterations = 700;
+        config.optimize.level_window = 0;
         config.loss.keep_the_full_rig();
         config
     }
@@ -623,6 +635,14 @@ impl ReconstructConfig {
             (
                 r("optimize.checkpoint_interval", 0.0, 1e5),
                 self.optimize.checkpoint_interval as f64,
+            ),
+            (
+                r("optimize.level_window", 0.0, 1e5),
+                self.optimize.level_window as f64,
+            ),
+            (
+                r("optimize.level_tolerance", 0.0, 1.0),
+                self.optimize.level_tolerance,
             ),
             (
                 r("finish.untangle_margin", 0.0, 0.01),
@@ -923,6 +943,11 @@ mod tests {
         assert_eq!(c.finish.final_smoothing_sweeps, 3);
         assert_eq!(c.finish.data_flip_rounds, 5);
         assert_eq!(c.optimize.checkpoint_interval, 10);
+        assert_eq!(
+            (c.optimize.level_window, c.optimize.level_tolerance),
+            (50, 0.01)
+        );
+        assert_eq!(ReconstructConfig::sdf_defaults().optimize.level_window, 0);
         assert!(c.optimize.step_limiter);
         assert!(!c.optimize.guard_intersections, "off by default");
         assert_eq!(c.finish.final_qem_offset, 5e-4);

@@ -192,6 +192,9 @@ pub struct OptimizeStats {
     pub loss_last: f64,
     /// Loss, its terms and the face count at every iteration.
     pub history: Vec<IterationRecord>,
+    /// Iterations the loop ran: `iterations`, or fewer when the loss levelled off
+    /// (`level_window`).
+    pub loop_iterations: usize,
     /// Faces after the optimization loop.
     pub loop_faces: usize,
     /// Accepted operations per block over the loop, by block name.
@@ -201,8 +204,8 @@ pub struct OptimizeStats {
     /// Loss of the loop's last state (evaluated once more after the last iteration; NaN, null
     /// in the report, when no checkpoint was kept to compare it with).
     pub loss_of_last_state: f64,
-    /// The iteration whose starting state the run finished from (`iterations` for the state
-    /// after the last one): the lowest-loss state of the checkpoints and the last one that the
+    /// The iteration whose starting state the run finished from (`loop_iterations` for the
+    /// state after the last one): the lowest-loss state of the checkpoints and the last one that the
     /// untangle block could clear (`checkpoint_interval`).
     pub finished_from_iteration: usize,
     /// States with a lower loss that the untangle block could not clear, in the order tried.

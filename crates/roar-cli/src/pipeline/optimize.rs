@@ -80,7 +80,7 @@ fn target_renders<'s>(
 }
 
 /// Runs `config.iterations` iterations of the loop on `mesh` (a Move Vertices step, then the
-/// blocks due) and returns the states to finish from: the checkpoints, each with the loss
+/// blocks due), fewer when the loss levels off ([`levelled_off`]), and returns the states to finish from: the checkpoints, each with the loss
 /// before its iteration's step, and the last state with its loss (NaN when there is no
 /// checkpoint to compare it with).
 pub(super) fn optimize(
@@ -150,6 +150,11 @@ pub(super) fn optimize(
             }
         }
         run.report("optimize", iteration, value, mesh.n_faces())?;
+        run.stats.optimize.loop_iterations = iteration + 1;
+        let level = &config.optimize;
+        if levelled_off(&states, level.level_window, level.level_tolerance) {
+            break;
+        }
     }
     run.stats.optimize.loop_faces = mesh.n_faces();
 
@@ -162,12 +167,33 @@ pub(super) fn optimize(
     };
     run.stats.optimize.loss_of_last_state = last;
     states.push(LoopState {
-        iteration: config.optimize.iterations,
+        iteration: run.stats.optimize.loop_iterations,
         loss: last,
         mesh,
     });
     run.clock.lap("loop_loss");
     Ok(states)
+}
+
+/// Whether the loss has levelled off at the newest of the checkpoint `states` (in iteration
+/// order): none of those of the last `window` iterations is `tolerance` (relative) below the
+/// lowest loss before them. Never with `window == 0` or before iteration `window`.
+fn levelled_off(states: &[LoopState], window: usize, tolerance: f64) -> bool {
+    let Some(newest) = states.last() else {
+        return false;
+    };
+    if window == 0 || newest.iteration < window {
+        return false;
+    }
+    let start = newest.iteration - window;
+    let lowest = |recent: bool| {
+        states
+            .iter()
+            .filter(|s| (s.iteration > start) == recent)
+            .map(|s| s.loss)
+            .fold(f64::INFINITY, f64::min)
+    };
+    lowest(true) > lowest(false) * (1.0 - tolerance)
 }
 
 /// A state of the loop's mesh and its loss.
@@ -250,4 +276,43 @@ fn compact_triangles(mesh: &mut Mesh, optimizer: &mut Optimizer) -> Vec<[u32; 3]
 /// Accepted operations of a block, including nested blocks (the flips of Face Collapse).
 fn total_accepted(stats: &BlockStats) -> usize {
     stats.accepted + stats.sub.iter().map(total_accepted).sum::<usize>()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Checkpoint states every 10 iterations with the given losses.
+    fn states(losses: &[f64]) -> Vec<LoopState> {
+        let mesh = roar_mesh::shapes::cube();
+        losses
+            .iter()
+            .enumerate()
+            .map(|(k, &loss)| LoopState {
+                iteration: 10 * k,
+                loss,
+                mesh: mesh.clone(),
+            })
+            .collect()
+    }
+
+    #[test]
+    fn the_loop_stops_when_a_whole_window_brings_the_lowest_loss_down_by_less_than_the_tolerance() {
+        // Falling 2 % per checkpoint: never levelled off.
+        let falling: Vec<f64> = (0..10).map(|k| 0.98f64.powi(k)).collect();
+        for n in 1..=falling.len() {
+            assert!(!levelled_off(&states(&falling[..n]), 30, 0.01));
+        }
+        // Flat from iteration 30 (the fourth checkpoint): the window (30, 60] brings nothing.
+        let flat = [1.0, 0.5, 0.4, 0.3, 0.3, 0.31, 0.3];
+        assert!(!levelled_off(&states(&flat[..6]), 30, 0.01));
+        assert!(levelled_off(&states(&flat), 30, 0.01));
+        // A gain of 2 % inside the window is above a 1 % tolerance, not above a 5 % one.
+        let slow = [1.0, 0.5, 0.4, 0.3, 0.3, 0.3, 0.294];
+        assert!(!levelled_off(&states(&slow), 30, 0.01));
+        assert!(levelled_off(&states(&slow), 30, 0.05));
+        // A window of 0 never stops; nor does any window before its own length.
+        assert!(!levelled_off(&states(&flat), 0, 0.01));
+        assert!(!levelled_off(&states(&flat), 70, 0.01));
+    }
 }
