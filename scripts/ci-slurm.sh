@@ -134,8 +134,10 @@ planar_max_samples = 5000
 working_budget_min = 600
 split_interval = 3
 smoothing_interval = 2
+level_window = 0
 TOML
-# Shard 1 of 2 runs `b` then `slow`: `slow` has enough iterations to be cancelled mid-item.
+# Shard 1 of 2 runs `b` then `slow`: `slow` has enough iterations to be cancelled mid-item (all
+# of them run: `level_window = 0`).
 cat > "$data/manifest.csv" <<CSV
 id,path,iterations
 a,chair.obj,

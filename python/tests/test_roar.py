@@ -139,7 +139,8 @@ def test_progress_gets_the_cli_records_and_its_exception_stops_the_run():
 
 def test_ctrl_c_raises_keyboard_interrupt_and_stops_the_run():
     v, f = example()
-    long_run = dict(TOY, optimize=dict(TOY["optimize"], iterations=500))
+    # All 500 iterations run unless interrupted (no stop when the loss levels off).
+    long_run = dict(TOY, optimize=dict(TOY["optimize"], iterations=500, level_window=0))
     optimize = []
 
     def on_progress(record):
