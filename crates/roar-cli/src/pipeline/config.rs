@@ -288,7 +288,8 @@ pub struct OptimizeConfig {
     /// one before them (0 = always run `iterations`; needs `checkpoint_interval > 0`).
     /// Defaults 50 and 0.01; off in the SDF schedule, whose SDF loss starts at iteration 500.
     /// [INF] Not in the paper: the run finishes from the lowest-loss checkpoint, and on the wild
-    /// meshes the loss levels off by iteration 50–100 (`docs/method.md`, "When the loop stops").
+    /// meshes the loss levels off by iteration 50–100 (`docs/method.md`, "The loop stops when its
+    /// loss has levelled off").
     pub level_window: usize,
     /// See `level_window`.
     pub level_tolerance: f64,

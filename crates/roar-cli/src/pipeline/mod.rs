@@ -205,8 +205,8 @@ pub struct OptimizeStats {
     /// in the report, when no checkpoint was kept to compare it with).
     pub loss_of_last_state: f64,
     /// The iteration whose starting state the run finished from (`loop_iterations` for the
-    /// state after the last one): the lowest-loss state of the checkpoints and the last one that the
-    /// untangle block could clear (`checkpoint_interval`).
+    /// state after the last one): the lowest-loss state of the checkpoints and the last one
+    /// that the untangle block could clear (`checkpoint_interval`).
     pub finished_from_iteration: usize,
     /// States with a lower loss that the untangle block could not clear, in the order tried.
     pub untangle_failures: Vec<UntangleFailure>,

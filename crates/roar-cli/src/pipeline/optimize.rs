@@ -80,9 +80,9 @@ fn target_renders<'s>(
 }
 
 /// Runs `config.iterations` iterations of the loop on `mesh` (a Move Vertices step, then the
-/// blocks due), fewer when the loss levels off ([`levelled_off`]), and returns the states to finish from: the checkpoints, each with the loss
-/// before its iteration's step, and the last state with its loss (NaN when there is no
-/// checkpoint to compare it with).
+/// blocks due), fewer when the loss levels off ([`levelled_off`]), and returns the states to
+/// finish from: the checkpoints, each with the loss before its iteration's step, and the last
+/// state with its loss (NaN when there is no checkpoint to compare it with).
 pub(super) fn optimize(
     mut mesh: Mesh,
     loss: &mut dyn Loss,
