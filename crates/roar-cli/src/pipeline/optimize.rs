@@ -112,6 +112,9 @@ pub(super) fn optimize(
             "loop",
         )?;
         let value = record.loss;
+        // Whether this iteration's checkpoint shows the loss levelled off: the loop then ends
+        // after the iteration's blocks.
+        let mut levelled = false;
         if let Some(mesh) = candidate {
             // `value` is the loss of the state before this iteration's step.
             states.push(LoopState {
@@ -119,6 +122,8 @@ pub(super) fn optimize(
                 loss: value,
                 mesh,
             });
+            let level = &config.optimize;
+            levelled = levelled_off(&states, level.level_window, level.level_tolerance);
             run.clock.lap("loop_checkpoint");
         }
         let stats = &mut run.stats;
@@ -151,8 +156,7 @@ pub(super) fn optimize(
         }
         run.report("optimize", iteration, value, mesh.n_faces())?;
         run.stats.optimize.loop_iterations = iteration + 1;
-        let level = &config.optimize;
-        if levelled_off(&states, level.level_window, level.level_tolerance) {
+        if levelled {
             break;
         }
     }
@@ -176,8 +180,9 @@ pub(super) fn optimize(
 }
 
 /// Whether the loss has levelled off at the newest of the checkpoint `states` (in iteration
-/// order): none of those of the last `window` iterations is `tolerance` (relative) below the
-/// lowest loss before them. Never with `window == 0` or before iteration `window`.
+/// order, the newest just kept): none of those of the last `window` iterations is `tolerance`
+/// (relative) below the lowest loss before them. Never with `window == 0` or before iteration
+/// `window`.
 fn levelled_off(states: &[LoopState], window: usize, tolerance: f64) -> bool {
     let Some(newest) = states.last() else {
         return false;
