@@ -7,6 +7,8 @@
 //! (stop-gradient), so `∂L/∂s_i = −2·scale·d_i / N` and each sample passes its gradient to its
 //! face's three vertices through its barycentric weights.
 
+use std::borrow::Cow;
+
 use glam::DVec3;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -47,6 +49,13 @@ pub const DEFAULT_PLANAR_SCALE: f64 = 5.0;
 /// do not). Its effect on `roar reconstruct`'s outputs: `docs/method.md`.
 pub const DEFAULT_MAX_SAMPLES: usize = 25_000;
 
+/// Default cap on the target points the t2s term queries per evaluation
+/// ([`PlanarOptions::t2s_max_points`]). [INF] Every target point's nearest-sample query
+/// (229k on a soup: the cloud plus its sharp-edge samples) is the largest single kernel of a
+/// 1000-face run; a spatially even fifth of them per evaluation, a different fifth each time,
+/// measured on the 14 wild meshes: `docs/method.md`.
+pub const DEFAULT_T2S_MAX_POINTS: usize = 50_000;
+
 /// Options of [`PlanarLoss`] (spec §3.2.2, §3.3, OQ-3).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct PlanarOptions {
@@ -56,6 +65,11 @@ pub struct PlanarOptions {
     pub t2s: bool,
     /// t2s moves a sample only if `m_{t*}·n_i ≥` this. Default 0.95 (spec §3.2.2 t2s step 3).
     pub t2s_normal_dot: f64,
+    /// Most target points the t2s term queries per evaluation (default
+    /// [`DEFAULT_T2S_MAX_POINTS`]; 0 = all, as the spec). Above it, every `s`-th point of the
+    /// cloud's spatial order, `s = ⌈points/cap⌉`, from an offset that advances by one per
+    /// evaluation, so `s` consecutive evaluations query every point once ([`t2s_subset`]).
+    pub t2s_max_points: usize,
     /// Regular sampling of the source (spec §3.3: δ = 0.002, n ≤ 16, n ≥ 3).
     pub sampling: RegularSamplingOptions,
     /// Cap on source samples per evaluation (default [`DEFAULT_MAX_SAMPLES`]). Above it, every
@@ -76,6 +90,7 @@ impl Default for PlanarOptions {
             knn: KnnOptions::default(),
             t2s: true,
             t2s_normal_dot: 0.95,
+            t2s_max_points: DEFAULT_T2S_MAX_POINTS,
             sampling: RegularSamplingOptions::default(),
             max_samples: DEFAULT_MAX_SAMPLES,
             scale: DEFAULT_PLANAR_SCALE,
@@ -116,6 +131,8 @@ pub struct PlanarLoss {
     projector: KnnPlanarProjector,
     options: PlanarOptions,
     rng: ChaCha8Rng,
+    /// Evaluations so far: which subset of the target points the t2s term queries.
+    evaluations: usize,
     /// Statistics of the last evaluation.
     pub last_stats: PlanarStats,
 }
@@ -132,6 +149,7 @@ impl PlanarLoss {
             projector: KnnPlanarProjector::new(points, normals, &options.knn)?,
             options: *options,
             rng: ChaCha8Rng::seed_from_u64(options.seed),
+            evaluations: 0,
             last_stats: PlanarStats::default(),
         })
     }
@@ -173,7 +191,11 @@ impl PlanarLoss {
             self.projector.points(),
             self.projector.normals(),
             self.options.t2s_normal_dot,
-            self.projector.spatial_order(),
+            &t2s_subset(
+                self.projector.spatial_order(),
+                self.options.t2s_max_points,
+                self.evaluations,
+            ),
         );
         let from_t2s = s2t
             .iter()
@@ -218,6 +240,7 @@ impl Loss for PlanarLoss {
         } = self.draw_samples(positions, triangles);
 
         let (moves, from_t2s) = self.moves_and_t2s_count(&points, &normals);
+        self.evaluations += 1;
         let targets: Vec<Option<DVec3>> = moves
             .iter()
             .zip(&points)
@@ -317,6 +340,25 @@ impl SampleTree {
             .map(|&local| self.finite[local as usize] as u32)
             .collect()
     }
+}
+
+/// The target points (indices in the cloud's spatial `order`) the t2s term queries at
+/// evaluation `evaluation` under the cap `max_points` (0 = all): every `s`-th of `order`,
+/// `s = ⌈len/max_points⌉`, from offset `evaluation mod s`. Spatially even, since `order` is
+/// coherent; the subsets of `s` consecutive evaluations partition `order`.
+fn t2s_subset(order: &[u32], max_points: usize, evaluation: usize) -> Cow<'_, [u32]> {
+    if max_points == 0 || order.len() <= max_points {
+        return Cow::Borrowed(order);
+    }
+    let stride = order.len().div_ceil(max_points);
+    Cow::Owned(
+        order
+            .iter()
+            .skip(evaluation % stride)
+            .step_by(stride)
+            .copied()
+            .collect(),
+    )
 }
 
 /// [`t2s_moves`] with the samples' `tree` (built over `samples`), visiting the target points
@@ -610,12 +652,35 @@ mod tests {
         assert_eq!(o.max_samples, DEFAULT_MAX_SAMPLES);
         assert!(o.t2s);
         assert_eq!(o.t2s_normal_dot, 0.95);
+        assert_eq!(o.t2s_max_points, DEFAULT_T2S_MAX_POINTS);
+        assert_eq!(DEFAULT_T2S_MAX_POINTS, 50_000);
         assert_eq!(PlanarOptions::raw().scale, 1.0);
         assert_eq!(
             (o.knn.k, o.knn.normal_dot_threshold, o.knn.blowup_guard),
             (10, 0.01, 1.01)
         );
         assert_eq!(o.knn.mode, crate::knn_projector::PlanarMode::AlongNormal);
+    }
+
+    #[test]
+    fn t2s_subsets_of_consecutive_evaluations_partition_the_cloud() {
+        let order: Vec<u32> = (0..23).rev().collect();
+        // Under the cap, or without one, every evaluation queries every point in order.
+        for (cap, evaluation) in [(0, 0), (0, 5), (23, 1), (100, 2)] {
+            assert_eq!(&*t2s_subset(&order, cap, evaluation), &order[..]);
+        }
+        // 23 points under a cap of 5: stride 5, subsets of 5 or 4 points, each in order, and
+        // the 5 consecutive evaluations from any start query each point exactly once.
+        assert_eq!(&*t2s_subset(&order, 5, 0), &[22, 17, 12, 7, 2]);
+        assert_eq!(&*t2s_subset(&order, 5, 9), &[18, 13, 8, 3]);
+        for start in [0, 3, 7] {
+            let mut seen: Vec<u32> = (start..start + 5)
+                .flat_map(|e| t2s_subset(&order, 5, e).into_owned())
+                .collect();
+            assert!((start..start + 5).all(|e| t2s_subset(&order, 5, e).len() <= 5));
+            seen.sort_unstable();
+            assert_eq!(seen, (0..23).collect::<Vec<u32>>());
+        }
     }
 
     #[test]

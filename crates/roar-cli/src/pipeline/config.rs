@@ -188,6 +188,10 @@ pub struct LossConfig {
     pub planar_neighbours: usize,
     /// Include the target-to-source term (OQ-3).
     pub planar_t2s: bool,
+    /// Target points the t2s term queries per evaluation, a different spatially even subset
+    /// each time (0: all, the paper's; the default and why:
+    /// `roar_loss::planar::DEFAULT_T2S_MAX_POINTS`; 0 in the SDF and scan schedules).
+    pub planar_t2s_max_points: usize,
     /// Side in pixels of the coarse views the render loss uses for the loop's first
     /// `render_coarse_fraction` of iterations, when below `render_resolution`
     /// (`roar_loss::CoarseViews`; the paper renders every iteration at `render_resolution`,
@@ -208,11 +212,12 @@ pub struct LossConfig {
 
 impl LossConfig {
     /// The paper's loss schedule: every iteration renders the full rig, the planar loss keeps
-    /// 50,000 samples. The SDF and scan schedules use it: the faster soup schedule
-    /// (`docs/method.md`) is measured on soups only.
+    /// 50,000 samples and its t2s term queries every target point. The SDF and scan schedules
+    /// use it: the faster soup schedule (`docs/method.md`) is measured on soups only.
     fn keep_the_full_rig(&mut self) {
         self.render_coarse_fraction = 0.0;
         self.planar_max_samples = 50_000;
+        self.planar_t2s_max_points = 0;
     }
 }
 
@@ -225,6 +230,7 @@ impl Default for LossConfig {
             planar_max_samples: roar_loss::planar::DEFAULT_MAX_SAMPLES,
             planar_neighbours: 10,
             planar_t2s: true,
+            planar_t2s_max_points: roar_loss::planar::DEFAULT_T2S_MAX_POINTS,
             render_coarse_resolution: 256,
             render_coarse_fraction: 1.0,
             sdf_loss_weight: 0.1,
@@ -581,6 +587,10 @@ impl ReconstructConfig {
                 self.loss.planar_neighbours as f64,
             ),
             (
+                r("loss.planar_t2s_max_points", 0.0, 1e9),
+                self.loss.planar_t2s_max_points as f64,
+            ),
+            (
                 r("target.point_cloud_samples", 100.0, 5e7),
                 self.target.point_cloud_samples as f64,
             ),
@@ -906,6 +916,7 @@ mod tests {
             roar_loss::planar::DEFAULT_MAX_SAMPLES
         );
         assert_eq!(c.loss.planar_neighbours, 10);
+        assert_eq!(c.loss.planar_t2s_max_points, 50_000);
         assert_eq!(
             (
                 c.loss.render_coarse_resolution,
@@ -919,8 +930,12 @@ mod tests {
         ] {
             let loss = &other.loss;
             assert_eq!(
-                (loss.render_coarse_fraction, loss.planar_max_samples),
-                (0.0, 50_000)
+                (
+                    loss.render_coarse_fraction,
+                    loss.planar_max_samples,
+                    loss.planar_t2s_max_points
+                ),
+                (0.0, 50_000, 0)
             );
         }
         assert_eq!(c.target.point_cloud_samples, 200_000);

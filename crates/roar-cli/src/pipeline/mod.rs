@@ -416,6 +416,7 @@ pub fn planar_options(config: &ReconstructConfig) -> PlanarOptions {
             ..KnnOptions::default()
         },
         t2s: config.loss.planar_t2s,
+        t2s_max_points: config.loss.planar_t2s_max_points,
         max_samples: config.loss.planar_max_samples,
         scale: config.loss.planar_scale,
         seed: config.seed,
