@@ -361,9 +361,10 @@ fn t2s_subset(order: &[u32], max_points: usize, evaluation: usize) -> Cow<'_, [u
     )
 }
 
-/// [`t2s_moves`] with the samples' `tree` (built over `samples`), visiting the target points
-/// in `order` (a permutation of their indices; a spatially coherent one makes the searches
-/// cheaper, the result does not depend on it).
+/// [`t2s_moves`] with the samples' `tree` (built over `samples`), over the target points
+/// listed in `order` only (indices, each at most once: all of them, or a [`t2s_subset`]),
+/// visited in that order (a spatially coherent one makes the searches cheaper; the result
+/// does not depend on the order, only on which points it lists).
 fn t2s_moves_in_order(
     samples: &[DVec3],
     sample_normals: &[DVec3],
@@ -681,6 +682,41 @@ mod tests {
             seen.sort_unstable();
             assert_eq!(seen, (0..23).collect::<Vec<u32>>());
         }
+    }
+
+    /// A flat unit square against a grid of target points on it plus one point 0.3 above its
+    /// middle, which only the t2s term reaches (it is never among a sample's 10 nearest): the
+    /// evaluation's largest move is about 0.3 exactly when the t2s term queries that point.
+    /// Under a cap of half the cloud, one of any two consecutive evaluations does; without a
+    /// cap, both.
+    #[test]
+    fn the_loss_queries_the_capped_subset_of_its_evaluation() {
+        let mut points: Vec<DVec3> = (0..21)
+            .flat_map(|i| (0..21).map(move |j| DVec3::new(i as f64, j as f64, 0.0) / 20.0))
+            .collect();
+        points.push(DVec3::new(0.5, 0.5, 0.3));
+        let normals = vec![DVec3::Z; points.len()];
+        let positions = [DVec3::ZERO, DVec3::X, DVec3::new(1.0, 1.0, 0.0), DVec3::Y];
+        let triangles = [[0, 1, 2], [0, 2, 3]];
+        let reaches_the_point = |cap: usize| -> Vec<bool> {
+            let options = PlanarOptions {
+                t2s_max_points: cap,
+                ..PlanarOptions::default()
+            };
+            let mut loss = PlanarLoss::new(&points, &normals, &options).unwrap();
+            (0..4)
+                .map(|_| {
+                    loss.value_and_grad(&positions, &triangles).unwrap();
+                    loss.last_stats.max_move > 0.2
+                })
+                .collect()
+        };
+        assert_eq!(reaches_the_point(0), [true; 4]);
+        let capped = reaches_the_point(points.len() / 2);
+        assert!(
+            capped == [true, false, true, false] || capped == [false, true, false, true],
+            "{capped:?}"
+        );
     }
 
     #[test]
