@@ -391,6 +391,14 @@ pub struct FinishConfig {
     /// their vertices on chords (`docs/sdf.md`, "Measured cost"). Soups have no field and skip
     /// it. Runs only when `iterations > 0`.
     pub zero_set_steps: usize,
+    /// For an SDF input, before the fit to the zero set: a vertex whose first-order distance
+    /// `|f|/|∇f|` from the zero set exceeds this times its mean edge length is collapsed into a
+    /// neighbour (the nearest to the zero set first) where no face turns over and no
+    /// intersection appears, and the face count is restored by edge splits
+    /// (`roar_ops::finish::fins`; default 0.5; 0 = off). [INF] Not in the paper: the untangle
+    /// can leave fins, flaps of faces standing off the surface that the fit would fold onto
+    /// themselves and so holds (`docs/sdf.md`). Runs only when `iterations > 0`.
+    pub fin_distance_over_edge: f64,
     /// Last step: flip the edges of faces with aspect ratio `Q = R/(2r)` above this when both faces
     /// of the edge get better, the two are nearly coplanar (0.95; against the other face alone when
     /// one is degenerate, above 100) and no intersection appears (`roar_ops::finish::slivers`;
@@ -418,6 +426,7 @@ impl Default for FinishConfig {
             data_flip_rounds: 5,
             polish_iterations: 20,
             zero_set_steps: 3,
+            fin_distance_over_edge: 0.5,
             sliver_quality: 10.0,
             best_effort: false,
             keep_topology: false,
@@ -670,6 +679,10 @@ impl ReconstructConfig {
             (
                 r("finish.zero_set_steps", 0.0, 100.0),
                 self.finish.zero_set_steps as f64,
+            ),
+            (
+                off("finish.fin_distance_over_edge", 0.01, 100.0),
+                self.finish.fin_distance_over_edge,
             ),
             (
                 off("finish.sliver_quality", 1.0, 1e6),
@@ -969,5 +982,6 @@ mod tests {
         assert_eq!(c.finish.final_qem_offset, 5e-4);
         assert_eq!(c.finish.polish_iterations, 20);
         assert_eq!(c.finish.sliver_quality, 10.0);
+        assert_eq!(c.finish.fin_distance_over_edge, 0.5);
     }
 }

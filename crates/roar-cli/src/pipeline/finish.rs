@@ -1,9 +1,9 @@
 //! The finish stage: the lowest-loss loop state the untangle block clears, filled to N; the
 //! final QEMs (to 2N and polish first when the mesh is larger), each followed by smoothing,
-//! data flips and the polish; for an SDF input the fit to the field's zero set; then
-//! sliver flips. Every step after the QEMs goes through
-//! [`keep_if_clean`]: it is kept only if the mesh stays free of self-intersections in the
-//! input's coordinates, where it will be written.
+//! data flips and the polish; for an SDF input the fin collapses and the fit to the field's
+//! zero set; then sliver flips. Every step after the QEMs goes through [`keep_if_clean`]: it is
+//! kept only if the mesh stays free of self-intersections in the input's coordinates, where it
+//! will be written.
 
 use std::convert::Infallible;
 
@@ -16,6 +16,7 @@ use roar_ops::decimate::{DecimateOptions, DecimateStats, decimate};
 use roar_ops::finish::data_flips::{DataFlipOptions, flip_toward_target};
 use roar_ops::finish::degenerate::{DegenerateOptions, collapse_degenerate_faces};
 use roar_ops::finish::fill::fill_to_budget;
+use roar_ops::finish::fins::{FinOptions, collapse_fins};
 use roar_ops::finish::genus::{HandleRemovalOptions, decimate_removing_handles, remove_handles};
 use roar_ops::finish::offset::offset_outward;
 use roar_ops::finish::slivers::{SliverOptions, flip_slivers};
@@ -97,7 +98,7 @@ pub(super) fn finish(
     drop(loss);
     if let Some(field) = field
         && config.optimize.iterations > 0
-        && config.finish.zero_set_steps > 0
+        && (config.finish.zero_set_steps > 0 || config.finish.fin_distance_over_edge > 0.0)
     {
         mesh = fit_to_zero_set_if_clean(mesh, field, normalization, config, &mut run.stats);
         run.clock.lap("zero_set");
@@ -332,7 +333,8 @@ fn flip_toward_cloud_if_clean(
     mesh
 }
 
-/// The mesh fitted to `field`'s zero set (`roar_ops::finish::zero_set`), kept only if the
+/// The mesh with its fins collapsed (`roar_ops::finish::fins`, the face count restored by edge
+/// splits) and fitted to `field`'s zero set (`roar_ops::finish::zero_set`), kept only if the
 /// result is free of self-intersections in the input's coordinates, as for the smoothing.
 fn fit_to_zero_set_if_clean(
     mesh: Mesh,
@@ -341,17 +343,31 @@ fn fit_to_zero_set_if_clean(
     config: &ReconstructConfig,
     stats: &mut RunStats,
 ) -> Mesh {
-    let options = ZeroSetOptions {
+    let fin_options = FinOptions {
+        max_distance_over_edge: config.finish.fin_distance_over_edge,
+        epsilon: config.loss.sdf_loss_epsilon,
+        ..FinOptions::default()
+    };
+    let fit_options = ZeroSetOptions {
         steps: config.finish.zero_set_steps,
         epsilon: config.loss.sdf_loss_epsilon,
         ..ZeroSetOptions::default()
     };
+    let mut collapsed = 0;
     let mut fit = ZeroSetStats::default();
-    let (mesh, moved) = keep_if_clean(mesh, normalization, |moved| {
-        fit = fit_to_zero_set(moved, field, &options);
-        fit.fitted + fit.shortened
+    let (mesh, changed) = keep_if_clean(mesh, normalization, |moved| {
+        if fin_options.max_distance_over_edge > 0.0 {
+            let faces = moved.n_faces();
+            collapsed = collapse_fins(moved, field, &fin_options).accepted;
+            fill_to_budget(moved, faces);
+        }
+        if fit_options.steps > 0 {
+            fit = fit_to_zero_set(moved, field, &fit_options);
+        }
+        collapsed + fit.fitted + fit.shortened
     });
-    if moved > 0 {
+    if changed > 0 {
+        stats.finish.fin_collapses = collapsed;
         stats.finish.zero_set_fitted = fit.fitted;
         stats.finish.zero_set_held = fit.shortened + fit.unmoved;
     }

@@ -239,6 +239,10 @@ pub struct FinishStats {
     /// Whether the last polished mesh was kept (false: it intersected itself, or no polish ran;
     /// true also when its best state was the unpolished one).
     pub polish_kept: bool,
+    /// Vertices far off the field's zero set collapsed before its fit (`fin_distance_over_edge`;
+    /// SDF inputs only; 0 also when the step was dropped because the mesh would have
+    /// intersected itself).
+    pub fin_collapses: usize,
     /// Vertices the fit to the field's zero set moved the whole way (`zero_set_steps`; SDF
     /// inputs only; 0 also when the moved mesh was dropped because it would have intersected
     /// itself).
