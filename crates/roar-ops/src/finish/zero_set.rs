@@ -3,8 +3,9 @@
 
 use glam::DVec3;
 use roar_mesh::Mesh;
-use roar_mesh::spatial::{Sdf, area_weighted_vertex_normals, triangle_normal};
+use roar_mesh::spatial::{Sdf, area_weighted_vertex_normals, triangle_normal, triangle_quality};
 
+use crate::geometry::{DEGENERATE_QUALITY, is_degenerate};
 use crate::untangle::{LimiterOptions, limit_steps};
 
 /// Options of [`fit_to_zero_set`].
@@ -38,7 +39,7 @@ pub struct ZeroSetStats {
     /// Vertices moved part of the way: a move too long for their faces, or one that would make
     /// faces intersect.
     pub shortened: usize,
-    /// Vertices left where they were: a move that would turn a face over or make faces
+    /// Vertices left where they were: a move that would turn a face over, make it degenerate or make faces
     /// intersect however short, or none to make.
     pub unmoved: usize,
 }
@@ -46,36 +47,73 @@ pub struct ZeroSetStats {
 /// Fits `mesh` to the zero set of `sdf`: `options.steps` times, every vertex moves along its
 /// normal by minus the mean first-order distance `f/|∇f|` over its faces (area-weighted, each
 /// face's mean taken at its edge midpoints, the quadrature exact for a distance quadratic over
-/// the face). Then each vertex's move is shortened to `max_move_fraction` of its smallest height,
-/// moves that would make faces intersect are shortened or cancelled (`limit_steps`) and moves
-/// that turn a face over (its normal against the old one) are undone, the limiter checking the
-/// positions again after each undoing. The topology stays; the mesh stays free of
+/// the face), each move shortened to `max_move_fraction` of the vertex's smallest height,
+/// shortened or cancelled where it would make faces intersect (`limit_steps`) and undone where
+/// it would turn a face over (its normal against the one before the step) or make it
+/// degenerate, the limiter
+/// checking the positions again after each undoing. The topology stays; the mesh stays free of
 /// self-intersections when it was.
 ///
 /// Why: the loop's mesh sits on the surface only as far as the render, planar and SDF losses
 /// pull it, and the fill splits that bring it to a large budget put their new vertices on the
 /// old edges' chords. On a field the surface is known everywhere. Each face is fitted, not each
 /// vertex: vertices on the zero set would put the faces of a curved part inside it (the chords
-/// of a sphere), which at 5,000 faces costs more than it gains.
+/// of a sphere), which at 5,000 faces costs more than it gains. Each step is limited against
+/// the faces as they are, so a vertex held by a small face in one step can go on once its
+/// neighbours have moved.
 pub fn fit_to_zero_set(mesh: &mut Mesh, sdf: &dyn Sdf, options: &ZeroSetOptions) -> ZeroSetStats {
     // Compact, the mesh's vertex, edge and face ids are dense, and the vertex ids are the
     // indices of `to_triangles`.
     mesh.compact();
-    let (positions, triangles) = mesh.to_triangles();
-    let mut fitted = positions.clone();
+    let (start, triangles) = mesh.to_triangles();
+    let mut positions = start.clone();
+    let mut held = vec![false; positions.len()];
     for _ in 0..options.steps {
-        let offsets = mean_distances(mesh, &fitted, sdf, options.epsilon);
-        let normals = area_weighted_vertex_normals(&fitted, &triangles);
-        for ((p, n), d) in fitted.iter_mut().zip(&normals).zip(&offsets) {
-            *p -= *n * *d;
+        let offsets = mean_distances(mesh, &positions, sdf, options.epsilon);
+        let normals = area_weighted_vertex_normals(&positions, &triangles);
+        let wanted: Vec<DVec3> = positions
+            .iter()
+            .zip(&normals)
+            .zip(&offsets)
+            .map(|((p, n), d)| *p - *n * *d)
+            .collect();
+        let moved = limited_step(&positions, &wanted, &triangles, options.max_move_fraction);
+        for ((h, m), w) in held.iter_mut().zip(&moved).zip(&wanted) {
+            *h |= m != w;
         }
+        positions = moved;
     }
 
-    let heights = smallest_heights(&positions, &triangles);
-    let mut targets = fitted.clone();
-    for ((target, &old), &height) in targets.iter_mut().zip(&positions).zip(&heights) {
+    let unmoved = positions.iter().zip(&start).filter(|(a, b)| a == b).count();
+    let fitted = positions
+        .iter()
+        .zip(&start)
+        .zip(&held)
+        .filter(|((a, b), h)| a != b && !**h)
+        .count();
+    mesh.positions_mut().copy_from_slice(&positions);
+    ZeroSetStats {
+        fitted,
+        shortened: positions.len() - fitted - unmoved,
+        unmoved,
+    }
+}
+
+/// The positions `wanted` from `positions` (an intersection-free mesh of `triangles`) allows:
+/// each move shortened to `max_move_fraction` of the vertex's smallest height, then shortened
+/// or cancelled where faces would intersect, and undone where a face would turn over or
+/// become degenerate.
+fn limited_step(
+    positions: &[DVec3],
+    wanted: &[DVec3],
+    triangles: &[[u32; 3]],
+    max_move_fraction: f64,
+) -> Vec<DVec3> {
+    let heights = smallest_heights(positions, triangles);
+    let mut targets = wanted.to_vec();
+    for ((target, &old), &height) in targets.iter_mut().zip(positions).zip(&heights) {
         let length = (*target - old).length();
-        let longest = options.max_move_fraction * height;
+        let longest = max_move_fraction * height;
         if !length.is_finite() {
             *target = old;
         } else if length > longest {
@@ -84,27 +122,13 @@ pub fn fit_to_zero_set(mesh: &mut Mesh, sdf: &dyn Sdf, options: &ZeroSetOptions)
     }
     // Each round that undoes a move leaves one more vertex where it was (the limiter never
     // moves a vertex past its target), so the loop ends.
-    let moved = loop {
+    loop {
         let mut moved = targets.clone();
-        limit_steps(
-            &positions,
-            &mut moved,
-            &triangles,
-            &LimiterOptions::default(),
-        );
-        if !undo_turned_faces(&positions, &mut moved, &triangles) {
-            break moved;
+        limit_steps(positions, &mut moved, triangles, &LimiterOptions::default());
+        if !undo_bad_faces(positions, &mut moved, triangles) {
+            return moved;
         }
         targets = moved;
-    };
-
-    let fitted = moved.iter().zip(&fitted).filter(|(a, b)| a == b).count();
-    let unmoved = moved.iter().zip(&positions).filter(|(a, b)| a == b).count();
-    mesh.positions_mut().copy_from_slice(&moved);
-    ZeroSetStats {
-        fitted,
-        shortened: positions.len() - fitted - unmoved,
-        unmoved,
     }
 }
 
@@ -176,17 +200,23 @@ fn smallest_heights(positions: &[DVec3], triangles: &[[u32; 3]]) -> Vec<f64> {
     heights
 }
 
-/// Puts back the corners of every face whose normal turned by more than 90° until none does
-/// (each round puts back at least one vertex, so it ends); returns whether it put any back.
-fn undo_turned_faces(before: &[DVec3], moved: &mut [DVec3], triangles: &[[u32; 3]]) -> bool {
+/// Puts back the corners of every face whose normal turned by more than 90° or that became
+/// degenerate (aspect ratio at or above [`DEGENERATE_QUALITY`]) until none does (each round puts
+/// back at least one vertex, so it ends); returns whether it put any back.
+fn undo_bad_faces(before: &[DVec3], moved: &mut [DVec3], triangles: &[[u32; 3]]) -> bool {
     let mut any = false;
     loop {
         let mut undone = 0;
         for t in triangles {
             let [a, b, c] = t.map(|i| i as usize);
-            let old = triangle_normal(before[a], before[b], before[c]);
-            let new = triangle_normal(moved[a], moved[b], moved[c]);
-            if old.dot(new) <= 0.0 {
+            let old = [before[a], before[b], before[c]];
+            let new = [moved[a], moved[b], moved[c]];
+            let turned = triangle_normal(old[0], old[1], old[2])
+                .dot(triangle_normal(new[0], new[1], new[2]))
+                <= 0.0;
+            let degenerated = is_degenerate(triangle_quality(new), DEGENERATE_QUALITY)
+                && !is_degenerate(triangle_quality(old), DEGENERATE_QUALITY);
+            if turned || degenerated {
                 for i in [a, b, c] {
                     if moved[i] != before[i] {
                         moved[i] = before[i];
@@ -233,7 +263,7 @@ mod tests {
     #[test]
     fn a_move_long_against_the_faces_is_shortened() {
         // Radius 0.5 against a unit-sphere field: every move (0.5) is longer than half of the
-        // smallest heights of a level-2 icosphere's faces, so each goes only that far.
+        // smallest heights of a level-2 icosphere's faces, so one step goes only that far.
         let mut mesh = icosphere(2);
         for p in mesh.positions_mut() {
             *p *= 0.5;
@@ -241,12 +271,37 @@ mod tests {
         let (before, triangles) = mesh.to_triangles();
         let heights = smallest_heights(&before, &triangles);
         let sphere = FnSdf::new(|p: DVec3| p.length() - 1.0);
-        let stats = fit_to_zero_set(&mut mesh, &sphere, &ZeroSetOptions::default());
+        let one_step = ZeroSetOptions {
+            steps: 1,
+            ..ZeroSetOptions::default()
+        };
+        let stats = fit_to_zero_set(&mut mesh, &sphere, &one_step);
         assert_eq!(stats.shortened, mesh.n_vertices());
         for ((p, old), height) in mesh.positions().iter().zip(&before).zip(&heights) {
             assert!(p.length() > old.length());
             let moved = (*p - *old).length();
             assert!((moved - 0.5 * height).abs() < 1e-9, "{moved} {height}");
+        }
+        mesh.validate().unwrap();
+    }
+
+    #[test]
+    fn each_step_is_limited_against_the_faces_as_they_are() {
+        // The same sphere with three steps: the faces grow as the vertices move out, so each
+        // step may go farther than the one before, and the mesh ends closer to the zero set
+        // than one step's half height allows.
+        let mut mesh = icosphere(2);
+        for p in mesh.positions_mut() {
+            *p *= 0.5;
+        }
+        let (before, triangles) = mesh.to_triangles();
+        let heights = smallest_heights(&before, &triangles);
+        let sphere = FnSdf::new(|p: DVec3| p.length() - 1.0);
+        fit_to_zero_set(&mut mesh, &sphere, &ZeroSetOptions::default());
+        for ((p, old), height) in mesh.positions().iter().zip(&before).zip(&heights) {
+            let moved = (*p - *old).length();
+            assert!(moved > 1.5 * 0.5 * height, "{moved} {height}");
+            assert!(p.length() < 1.0);
         }
         mesh.validate().unwrap();
     }
