@@ -188,6 +188,37 @@ pub fn flip_if_clean(
     true
 }
 
+/// Collapses `h` (its tail merged into its head, which keeps its position) unless the
+/// collapse is topologically illegal ([`Mesh::can_collapse`], `rejected["topology"]`) or a
+/// reshaped face would intersect another face (`rejected["intersection"]`), keeping `guard` in
+/// step (built at the first collapse that gets this far). Returns whether `h` was collapsed.
+/// The degenerate and fin collapses of a finished mesh share this last step.
+pub fn collapse_if_clean(
+    mesh: &mut Mesh,
+    h: HalfedgeId,
+    guard: &mut Option<IntersectionGuard>,
+    stats: &mut BlockStats,
+) -> bool {
+    if mesh.can_collapse(h).is_err() {
+        stats.reject("topology", 1);
+        return false;
+    }
+    let guard = guard.get_or_insert_with(|| IntersectionGuard::new(mesh));
+    let head = mesh.position(mesh.head(h));
+    if guard.collapse_intersects(mesh, h, head) {
+        stats.reject("intersection", 1);
+        return false;
+    }
+    let done = mesh
+        .collapse(h)
+        .expect("collapse passed can_collapse (invariant)");
+    for f in done.removed_faces {
+        guard.mark(f);
+    }
+    guard.mark_around(mesh, done.survivor);
+    true
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -33,7 +33,7 @@
 //! whose halves are not degenerate, longest first, which moves no geometry).
 
 use crate::blocks::block::BlockStats;
-use crate::blocks::guard::IntersectionGuard;
+use crate::blocks::guard::{IntersectionGuard, collapse_if_clean};
 use crate::geometry::{DEGENERATE_QUALITY, is_degenerate};
 use roar_mesh::spatial::{triangle_normal, triangle_quality};
 use roar_mesh::{FaceId, HalfedgeId, Mesh};
@@ -83,29 +83,14 @@ pub fn collapse_degenerate_faces(mesh: &mut Mesh, options: &DegenerateOptions) -
             }
             stats.candidates += 1;
             for h in halfedges_shortest_first(mesh, f) {
-                if mesh.can_collapse(h).is_err() {
-                    stats.reject("topology", 1);
-                    continue;
-                }
                 if let Err(reason) = reshaped_faces_ok(mesh, h, options) {
                     stats.reject(reason, 1);
                     continue;
                 }
-                let guard = guard.get_or_insert_with(|| IntersectionGuard::new(mesh));
-                let head = mesh.head(h);
-                if guard.collapse_intersects(mesh, h, mesh.position(head)) {
-                    stats.reject("intersection", 1);
-                    continue;
+                if collapse_if_clean(mesh, h, &mut guard, &mut stats) {
+                    collapsed += 1;
+                    break;
                 }
-                let done = mesh
-                    .collapse(h)
-                    .expect("degenerate collapse passed can_collapse (invariant)");
-                for f in done.removed_faces {
-                    guard.mark(f);
-                }
-                guard.mark_around(mesh, done.survivor);
-                collapsed += 1;
-                break;
             }
         }
         stats.accepted += collapsed;

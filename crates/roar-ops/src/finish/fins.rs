@@ -20,13 +20,14 @@
 //! the zero set first, and the collapse `a → b` (b keeps its position) is applied when
 //! 1. it is topologically legal ([`Mesh::can_collapse`]);
 //! 2. no reshaped face turns over (its normal against the old one) or becomes degenerate;
-//! 3. no reshaped face intersects another face ([`IntersectionGuard`], exact).
+//! 3. no reshaped face intersects another face
+//!    ([`IntersectionGuard`](crate::blocks::guard::IntersectionGuard), exact).
 //!
 //! Each collapse removes two faces; the caller restores the face count (the pipeline's fill
 //! splits edges, which moves no geometry) and fits the mesh to the zero set afterwards.
 
 use crate::blocks::block::BlockStats;
-use crate::blocks::guard::IntersectionGuard;
+use crate::blocks::guard::collapse_if_clean;
 use crate::geometry::{DEGENERATE_QUALITY, is_degenerate};
 use glam::DVec3;
 use roar_mesh::spatial::{Sdf, triangle_normal, triangle_quality};
@@ -68,7 +69,7 @@ pub fn collapse_fins(mesh: &mut Mesh, sdf: &dyn Sdf, options: &FinOptions) -> Bl
         if far.is_empty() {
             break;
         }
-        let mut guard = IntersectionGuard::new(mesh);
+        let mut guard = None;
         let mut collapsed = 0;
         for v in far {
             if !mesh.is_vertex_alive(v) {
@@ -80,28 +81,14 @@ pub fn collapse_fins(mesh: &mut Mesh, sdf: &dyn Sdf, options: &FinOptions) -> Bl
                 distances[mesh.head(x).index()].total_cmp(&distances[mesh.head(y).index()])
             });
             for h in outgoing {
-                if mesh.can_collapse(h).is_err() {
-                    stats.reject("topology", 1);
-                    continue;
-                }
                 if let Err(reason) = reshaped_faces_ok(mesh, h) {
                     stats.reject(reason, 1);
                     continue;
                 }
-                let head = mesh.position(mesh.head(h));
-                if guard.collapse_intersects(mesh, h, head) {
-                    stats.reject("intersection", 1);
-                    continue;
+                if collapse_if_clean(mesh, h, &mut guard, &mut stats) {
+                    collapsed += 1;
+                    break;
                 }
-                let done = mesh
-                    .collapse(h)
-                    .expect("fin collapse passed can_collapse (invariant)");
-                for f in done.removed_faces {
-                    guard.mark(f);
-                }
-                guard.mark_around(mesh, done.survivor);
-                collapsed += 1;
-                break;
             }
         }
         stats.accepted += collapsed;
