@@ -10,7 +10,7 @@
 //! | loop: Move Vertices | [`optim`] | the optimizer, its per-vertex state and how that state follows the mesh |
 //! | loop: remeshing | [`blocks`] | the `Block` trait; Face Collapse, flips, Face Split, smoothing; candidate selection, edge costs, the intersection guard |
 //! | loop and finish | [`untangle`] | the step limiter and the untangle block |
-//! | finish | [`finish`] | fill to the budget, outward offset, handle removal when the budget needs it, data flips, sliver flips, degenerate collapses |
+//! | finish | [`finish`] | fill to the budget, outward offset, handle removal when the budget needs it, data flips, sliver flips, degenerate collapses; for SDF inputs fin collapses and the fit to the zero set |
 //!
 //! Before the stages, for range scans: [`align`] (trimmed point-to-plane ICP of scan patches).
 //!
