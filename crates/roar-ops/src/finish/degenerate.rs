@@ -83,7 +83,9 @@ pub fn collapse_degenerate_faces(mesh: &mut Mesh, options: &DegenerateOptions) -
             }
             stats.candidates += 1;
             for h in halfedges_shortest_first(mesh, f) {
-                if let Err(reason) = reshaped_faces_ok(mesh, h, options) {
+                if let Err(reason) =
+                    reshaped_faces_ok(mesh, h, options.min_quality, options.min_normal_dot)
+                {
                     stats.reject(reason, 1);
                     continue;
                 }
@@ -120,11 +122,15 @@ fn halfedges_shortest_first(mesh: &Mesh, f: FaceId) -> Vec<HalfedgeId> {
     edges.iter().flat_map(|&h| [h, h.twin()]).collect()
 }
 
-/// Tests 2 and 3 of the module doc for collapsing `h` (its tail onto its head's position).
-fn reshaped_faces_ok(
+/// Whether collapsing `h` (its tail onto its head's position) keeps every reshaped face that
+/// was not degenerate (aspect ratio below `min_quality`) so, with its normal within
+/// `min_normal_dot` of the old one (tests 2 and 3 of the module doc; the fin collapses share
+/// it). A face that was degenerate may stay so: its old normal is rounding noise.
+pub(crate) fn reshaped_faces_ok(
     mesh: &Mesh,
     h: HalfedgeId,
-    options: &DegenerateOptions,
+    min_quality: f64,
+    min_normal_dot: f64,
 ) -> Result<(), &'static str> {
     let (a, b) = (mesh.tail(h), mesh.head(h));
     let removed = [mesh.face(h), mesh.face(h.twin())];
@@ -137,16 +143,15 @@ fn reshaped_faces_ok(
         let new = mesh
             .face_vertices(f)
             .map(|v| if v == a { pb } else { mesh.position(v) });
-        if is_degenerate(triangle_quality(old), options.min_quality) {
-            // It may stay degenerate, and its old normal is rounding noise.
+        if is_degenerate(triangle_quality(old), min_quality) {
             continue;
         }
-        if is_degenerate(triangle_quality(new), options.min_quality) {
+        if is_degenerate(triangle_quality(new), min_quality) {
             return Err("quality");
         }
         let turn =
             triangle_normal(old[0], old[1], old[2]).dot(triangle_normal(new[0], new[1], new[2]));
-        if turn < options.min_normal_dot {
+        if turn < min_normal_dot {
             return Err("normal");
         }
     }

@@ -19,7 +19,8 @@
 //! surface at all. Far vertices are taken farthest first; each tries its neighbours nearest to
 //! the zero set first, and the collapse `a → b` (b keeps its position) is applied when
 //! 1. it is topologically legal ([`Mesh::can_collapse`]);
-//! 2. no reshaped face turns over (its normal against the old one) or becomes degenerate;
+//! 2. no reshaped face that was not degenerate turns over or becomes degenerate (the test of
+//!    [`crate::finish::degenerate`], with any turn short of 90° allowed);
 //! 3. no reshaped face intersects another face
 //!    ([`IntersectionGuard`](crate::blocks::guard::IntersectionGuard), exact).
 //!
@@ -28,9 +29,10 @@
 
 use crate::blocks::block::BlockStats;
 use crate::blocks::guard::collapse_if_clean;
-use crate::geometry::{DEGENERATE_QUALITY, is_degenerate};
+use crate::finish::degenerate::reshaped_faces_ok;
+use crate::geometry::DEGENERATE_QUALITY;
 use glam::DVec3;
-use roar_mesh::spatial::{Sdf, triangle_normal, triangle_quality};
+use roar_mesh::spatial::Sdf;
 use roar_mesh::{HalfedgeId, Mesh, VertexId};
 
 /// Options of [`collapse_fins`].
@@ -60,7 +62,7 @@ impl Default for FinOptions {
 /// collapse.
 ///
 /// Stats: `candidates` = far vertices looked at (over all rounds); `accepted` = collapses;
-/// `rejected` (per half-edge tried): `"topology"`, `"turned"`, `"quality"`, `"intersection"`.
+/// `rejected` (per half-edge tried): `"topology"`, `"normal"`, `"quality"`, `"intersection"`.
 pub fn collapse_fins(mesh: &mut Mesh, sdf: &dyn Sdf, options: &FinOptions) -> BlockStats {
     let mut stats = BlockStats::new("fin_collapses");
     for _ in 0..options.max_rounds {
@@ -81,7 +83,7 @@ pub fn collapse_fins(mesh: &mut Mesh, sdf: &dyn Sdf, options: &FinOptions) -> Bl
                 distances[mesh.head(x).index()].total_cmp(&distances[mesh.head(y).index()])
             });
             for h in outgoing {
-                if let Err(reason) = reshaped_faces_ok(mesh, h) {
+                if let Err(reason) = reshaped_faces_ok(mesh, h, DEGENERATE_QUALITY, 0.0) {
                     stats.reject(reason, 1);
                     continue;
                 }
@@ -129,32 +131,6 @@ fn far_vertices(mesh: &Mesh, distances: &[f64], factor: f64) -> Vec<VertexId> {
         .collect();
     far.sort_by(|a, b| b.0.total_cmp(&a.0));
     far.into_iter().map(|(_, v)| v).collect()
-}
-
-/// Whether collapsing `h` (its tail onto its head) keeps every reshaped face facing the way it
-/// did and non-degenerate.
-fn reshaped_faces_ok(mesh: &Mesh, h: HalfedgeId) -> Result<(), &'static str> {
-    let (a, b) = (mesh.tail(h), mesh.head(h));
-    let removed = [mesh.face(h), mesh.face(h.twin())];
-    let pb = mesh.position(b);
-    for f in mesh.faces_around(a) {
-        if removed.contains(&f) {
-            continue;
-        }
-        let old = mesh.face_vertices(f).map(|v| mesh.position(v));
-        let new = mesh
-            .face_vertices(f)
-            .map(|v| if v == a { pb } else { mesh.position(v) });
-        if is_degenerate(triangle_quality(new), DEGENERATE_QUALITY) {
-            return Err("quality");
-        }
-        if triangle_normal(old[0], old[1], old[2]).dot(triangle_normal(new[0], new[1], new[2]))
-            <= 0.0
-        {
-            return Err("turned");
-        }
-    }
-    Ok(())
 }
 
 #[cfg(test)]
