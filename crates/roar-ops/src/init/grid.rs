@@ -76,6 +76,12 @@ impl Grid {
         self.origin + DVec3::new(c[0] as f64, c[1] as f64, c[2] as f64) * self.voxel_size
     }
 
+    /// World position of the centre of voxel `(i, j, k)` (any coordinates, also beyond the grid).
+    #[inline]
+    pub fn centre(&self, c: [usize; 3]) -> DVec3 {
+        self.corner(c) + DVec3::splat(0.5 * self.voxel_size)
+    }
+
     /// Continuous voxel coordinates of a world point.
     #[inline]
     pub fn to_grid(&self, p: DVec3) -> DVec3 {

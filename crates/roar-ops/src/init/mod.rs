@@ -544,7 +544,7 @@ pub fn sdf_init(
         .collect();
     let centers: Vec<DVec3> = interior
         .iter()
-        .map(|&idx| grid.corner(grid.coords(idx)) + DVec3::splat(0.5 * grid.voxel_size))
+        .map(|&idx| grid.centre(grid.coords(idx)))
         .collect();
     let mut values = vec![0.0; centers.len()];
     sdf.values(&centers, &mut values);
