@@ -1,10 +1,10 @@
 //! One evaluation of the loop's objective (spec §3.2.3: `3·L_render + 1·L_planar`, built by
-//! `roar_cli::pipeline::default_loss`) on a real mesh, and its parts on their own. The loop
-//! renders the coarse rig (36 views × 256², `render_coarse_resolution`), the finish's polish
-//! the full rig (36 × 512²): `loop_*` and `render_coarse_*` are the former, `full_*`,
-//! `render_forward_*` and `render_forward_backward_*` the latter; `planar_*` is the same in
-//! both. The fixture and sources (5,000 and 10,000 faces): `common/homer.rs`. Without
-//! `ROAR_TEST_DATA` the bench prints why and measures nothing.
+//! `roar_cli::pipeline::default_loss`) on a real mesh, and its parts on their own. The loop and
+//! the finish's polish render the coarse rig (36 views × 256², `render_coarse_resolution`), the
+//! paper the full rig (36 × 512², the SDF and scan schedules): `loop_*` and `render_coarse_*`
+//! are the former, `full_*`, `render_forward_*` and `render_forward_backward_*` the latter;
+//! `planar_*` is the same in both. The fixture and sources (5,000 and 10,000 faces):
+//! `common/homer.rs`. Without `ROAR_TEST_DATA` the bench prints why and measures nothing.
 // `criterion_group!` generates a public function without documentation.
 #![allow(missing_docs)]
 

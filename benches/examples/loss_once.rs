@@ -6,9 +6,9 @@
 //!     --toggle-collect='*value_and_grad*' target/release/examples/loss_once [FACES] [PART]
 //! ```
 //!
-//! FACES defaults to 10,000; PART is `loop` (default: the loop's objective, coarse rig),
-//! `full` (the polish's, full rig), `render` or `render_coarse` (forward + backward) or
-//! `planar`. Fixture and source: `benches/common/homer.rs`.
+//! FACES defaults to 10,000; PART is `loop` (default: the loop's and the polish's objective,
+//! coarse rig), `full` (the paper's, full rig), `render` or `render_coarse` (forward +
+//! backward) or `planar`. Fixture and source: `benches/common/homer.rs`.
 
 #[path = "../benches/common/homer.rs"]
 mod homer;

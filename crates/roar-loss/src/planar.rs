@@ -38,16 +38,16 @@ const CHUNK: usize = 4096;
 /// against the render gradient than on this sphere (`docs/method.md`).
 pub const DEFAULT_PLANAR_SCALE: f64 = 5.0;
 
-/// Default of [`PlanarOptions::max_samples`]: 25 000 source samples per evaluation (spec
+/// Default of [`PlanarOptions::max_samples`]: 12 500 source samples per evaluation (spec
 /// §3.2.2: the spec's density gives 150–300k on a typical shape). Measured by
 /// `examples/planar_profile.rs` (`CAP_STUDY=1`; 5 120-face bumpy sphere, 263k regular samples
 /// uncapped): the relative L2 error of one evaluation's gradient against uncapped evaluations
 /// is 5.2% uncapped (the floor set by the stochastic grid rounding), 6.1% at 100k, 8.7% at
-/// 50k, 13.5% at 25k. The samples are drawn afresh at every evaluation, so this error averages
-/// out over the iterations; one evaluation costs about two thirds of one at 50k (the k-NN
-/// queries and the t2s tree scale with the sample count, the t2s queries of the target points
-/// do not). Its effect on `roar reconstruct`'s outputs: `docs/method.md`.
-pub const DEFAULT_MAX_SAMPLES: usize = 25_000;
+/// 50k, 13.5% at 25k, 20% at 12.5k. The samples are drawn afresh at every evaluation, so this
+/// error averages out over the iterations; one evaluation at 12.5k costs about a third of one
+/// at 50k (the k-NN queries and the t2s tree scale with the sample count, the t2s queries of
+/// the target points do not). Its effect on `roar reconstruct`'s outputs: `docs/method.md`.
+pub const DEFAULT_MAX_SAMPLES: usize = 12_500;
 
 /// Default cap on the target points the t2s term queries per evaluation
 /// ([`PlanarOptions::t2s_max_points`]). [INF] Every target point's nearest-sample query
@@ -647,7 +647,7 @@ mod tests {
     #[test]
     fn documented_defaults() {
         assert_eq!(DEFAULT_PLANAR_SCALE, 5.0);
-        assert_eq!(DEFAULT_MAX_SAMPLES, 25_000);
+        assert_eq!(DEFAULT_MAX_SAMPLES, 12_500);
         let o = PlanarOptions::default();
         assert_eq!(o.scale, DEFAULT_PLANAR_SCALE);
         assert_eq!(o.max_samples, DEFAULT_MAX_SAMPLES);

@@ -198,9 +198,13 @@ pub struct LossConfig {
     /// `docs/method.md` says why not). Default 256.
     pub render_coarse_resolution: u32,
     /// Fraction of the loop's iterations rendered at `render_coarse_resolution`, from the
-    /// first (0: none, the paper's schedule; the finish's polish always renders at
-    /// `render_resolution`). Default 1: the whole loop; 0 in the SDF and scan schedules.
+    /// first (0: none, the paper's schedule). Default 1: the whole loop; 0 in the SDF and scan
+    /// schedules.
     pub render_coarse_fraction: f64,
+    /// When the whole loop renders at `render_coarse_resolution`, the finish's polish does too
+    /// (false: the polish renders at `render_resolution`). Default true (`docs/method.md` has
+    /// the cost and the fidelity of both).
+    pub render_coarse_polish: bool,
     /// Weight of the SDF projection loss (§5: 0.1), in the objective only for inputs with a
     /// signed distance (`roar_loss::SdfLoss`).
     pub sdf_loss_weight: f64,
@@ -233,6 +237,7 @@ impl Default for LossConfig {
             planar_t2s_max_points: roar_loss::planar::DEFAULT_T2S_MAX_POINTS,
             render_coarse_resolution: 256,
             render_coarse_fraction: 1.0,
+            render_coarse_polish: true,
             sdf_loss_weight: 0.1,
             sdf_loss_start: 500,
             sdf_loss_epsilon: 1e-10,
@@ -292,7 +297,7 @@ pub struct OptimizeConfig {
     /// Stop the loop once its loss has levelled off: at a checkpoint, when no checkpoint of the
     /// last `level_window` iterations has a loss `level_tolerance` (relative) below the lowest
     /// one before them (0 = always run `iterations`; needs `checkpoint_interval > 0`).
-    /// Defaults 50 and 0.01; off in the SDF schedule, whose SDF loss starts at iteration 500.
+    /// Defaults 30 and 0.01; off in the SDF schedule, whose SDF loss starts at iteration 500.
     /// [INF] Not in the paper: the run finishes from the lowest-loss checkpoint, and on the wild
     /// meshes the loss levels off by iteration 50–100 (`docs/method.md`, "The loop stops when its
     /// loss has levelled off").
@@ -335,7 +340,7 @@ impl Default for OptimizeConfig {
             split_threshold: 0.02,
             smoothing_interval: 0,
             checkpoint_interval: 10,
-            level_window: 50,
+            level_window: 30,
             level_tolerance: 0.01,
             step_limiter: true,
             guard_intersections: false,
@@ -923,7 +928,7 @@ mod tests {
         assert_eq!(c.target.twin_ratio, 80.0);
         assert_eq!((c.loss.render_weight, c.loss.planar_weight), (3.0, 1.0));
         assert_eq!(c.loss.planar_scale, 500.0);
-        assert_eq!(c.loss.planar_max_samples, 25_000);
+        assert_eq!(c.loss.planar_max_samples, 12_500);
         assert_eq!(
             c.loss.planar_max_samples,
             roar_loss::planar::DEFAULT_MAX_SAMPLES
@@ -933,9 +938,10 @@ mod tests {
         assert_eq!(
             (
                 c.loss.render_coarse_resolution,
-                c.loss.render_coarse_fraction
+                c.loss.render_coarse_fraction,
+                c.loss.render_coarse_polish
             ),
-            (256, 1.0)
+            (256, 1.0, true)
         );
         for other in [
             ReconstructConfig::sdf_defaults(),
@@ -974,7 +980,7 @@ mod tests {
         assert_eq!(c.optimize.checkpoint_interval, 10);
         assert_eq!(
             (c.optimize.level_window, c.optimize.level_tolerance),
-            (50, 0.01)
+            (30, 0.01)
         );
         assert_eq!(ReconstructConfig::sdf_defaults().optimize.level_window, 0);
         assert!(c.optimize.step_limiter);

@@ -387,8 +387,9 @@ pub fn rig_cameras(config: &ReconstructConfig) -> Vec<Camera> {
 }
 
 /// The coarse rig of `config`: the rig's views at `render_coarse_resolution²` pixels, for the
-/// loop's first `render_coarse_fraction` of iterations; empty when that fraction rounds to no
-/// iteration or the resolution is not below `render_resolution`.
+/// loop's first `render_coarse_fraction` of iterations (and the polish, see [`coarse_until`]);
+/// empty when that fraction rounds to no iteration or the resolution is not below
+/// `render_resolution`.
 pub fn coarse_rig_cameras(config: &ReconstructConfig) -> Vec<Camera> {
     let resolution = config.loss.render_coarse_resolution;
     if coarse_until(config) == 0 || resolution >= config.target.render_resolution {
@@ -398,9 +399,16 @@ pub fn coarse_rig_cameras(config: &ReconstructConfig) -> Vec<Camera> {
     star_cameras(views, views, resolution, resolution)
 }
 
-/// The first loop iteration rendered with the full rig.
+/// The first iteration rendered with the full rig; the finish's polish counts as iteration
+/// `iterations`, so it renders coarse too when the whole loop does and `render_coarse_polish`.
 fn coarse_until(config: &ReconstructConfig) -> usize {
-    (config.loss.render_coarse_fraction * config.optimize.iterations as f64).round() as usize
+    let iterations = config.optimize.iterations;
+    let coarse = (config.loss.render_coarse_fraction * iterations as f64).round() as usize;
+    if iterations > 0 && coarse >= iterations && config.loss.render_coarse_polish {
+        usize::MAX
+    } else {
+        coarse
+    }
 }
 
 /// The target renders' options of `config` (spec §3.1, §3.2.1), as the pipeline uses them.
@@ -577,7 +585,7 @@ mod tests {
     use super::*;
 
     #[test]
-    fn the_coarse_rig_is_the_rig_at_the_coarse_resolution_for_the_loops_first_iterations() {
+    fn the_coarse_rig_is_the_rig_at_the_coarse_resolution_for_the_loop_and_the_polish() {
         let mut config = ReconstructConfig::default();
         let (fine, coarse) = (rig_cameras(&config), coarse_rig_cameras(&config));
         assert_eq!(coarse.len(), fine.len());
@@ -585,7 +593,10 @@ mod tests {
             assert_eq!((c.width, c.height), (256, 256));
             assert_eq!((c.view, c.proj), (f.view, f.proj));
         }
-        assert_eq!(coarse_until(&config), 200, "the whole loop by default");
+        assert_eq!(coarse_until(&config), usize::MAX, "the loop and the polish");
+        config.loss.render_coarse_polish = false;
+        assert_eq!(coarse_until(&config), 200, "the whole loop only");
+        config.loss.render_coarse_polish = true;
         config.loss.render_coarse_fraction = 0.5;
         assert_eq!(coarse_until(&config), 100);
         // None when it would not be coarser, or would render no iteration.
