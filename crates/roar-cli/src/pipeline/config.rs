@@ -193,7 +193,8 @@ pub struct LossConfig {
     /// `roar_loss::planar::DEFAULT_T2S_MAX_POINTS`; 0 in the SDF and scan schedules).
     pub planar_t2s_max_points: usize,
     /// Side in pixels of the coarse views the render loss uses for the loop's first
-    /// `render_coarse_fraction` of iterations, when below `render_resolution`
+    /// `render_coarse_fraction` of iterations (and the polish, see `render_coarse_polish`), when
+    /// below `render_resolution`
     /// (`roar_loss::CoarseViews`; the paper renders every iteration at `render_resolution`,
     /// `docs/method.md` says why not). Default 256.
     pub render_coarse_resolution: u32,

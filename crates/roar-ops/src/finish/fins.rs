@@ -20,7 +20,7 @@
 //! the zero set first, and the collapse `a → b` (b keeps its position) is applied when
 //! 1. it is topologically legal ([`Mesh::can_collapse`]);
 //! 2. no reshaped face that was not degenerate turns over or becomes degenerate (the test of
-//!    [`crate::finish::degenerate`], with any turn short of 90° allowed);
+//!    [`crate::finish::degenerate`], with a turn of up to 90° allowed);
 //! 3. no reshaped face intersects another face
 //!    ([`IntersectionGuard`](crate::blocks::guard::IntersectionGuard), exact).
 //!
