@@ -49,9 +49,9 @@ pub fn parse_faces(text: &str) -> Result<usize, String> {
 
 /// Bytes a reconstruction is expected to need at its peak, from the sizes that drive it: the
 /// working budget `W` (the loop's mesh, its BVH and optimizer state, the renders' per-face
-/// buffers), the input's faces (the cleaned target and its BVH) and the fixed part (the 36
-/// target renders, the point cloud and its k-d tree). A rough linear model: the fixed and
-/// per-pixel parts match the measured peak of a short run (docs/reliability.md, "Memory"); the
+/// buffers), the input's faces (the cleaned target and its BVH), the target renders' pixels,
+/// the point cloud (and its k-d tree) and a fixed part. A rough linear model: the fixed and
+/// per-pixel parts match the measured peaks of short runs (docs/reliability.md, "Memory"); the
 /// per-face part is a deliberately high guess. It is meant to tell a budget that fits from one
 /// that cannot, not to predict a figure.
 pub fn estimated_peak_bytes(sizes: &RunSizes) -> u64 {
@@ -83,7 +83,7 @@ pub fn available_memory_bytes() -> Option<u64> {
     Some(kib * 1024)
 }
 
-const FIXED_BYTES: u64 = 64 << 20;
+const FIXED_BYTES: u64 = 128 << 20;
 const BYTES_PER_WORKING_FACE: u64 = 2048;
 const BYTES_PER_INPUT_FACE: u64 = 512;
 const BYTES_PER_PIXEL: u64 = 40;
