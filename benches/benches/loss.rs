@@ -1,6 +1,6 @@
 //! One evaluation of the loop's objective (spec §3.2.3: `3·L_render + 1·L_planar`, built by
-//! `roar_cli::pipeline::default_loss`) on a real mesh, and its parts on their own. The loop and
-//! the finish's polish render the coarse rig (36 views × 256², `render_coarse_resolution`), the
+//! `roar_cli::pipeline::default_loss`) on a real mesh, and its parts on their own. A soup's loop
+//! and polish render the default rig coarse (25 views × 256², `render_coarse_resolution`), the
 //! paper the full rig (36 × 512², the SDF and scan schedules): `loop_*` and `render_coarse_*`
 //! are the former, `full_*`, `render_forward_*` and `render_forward_backward_*` the latter;
 //! `planar_*` is the same in both. The fixture and sources (5,000 and 10,000 faces):
@@ -21,7 +21,7 @@ fn bench_loss(c: &mut Criterion) {
     let Some(homer) = Homer::load() else {
         return;
     };
-    let mut group = c.benchmark_group("loss_36_views");
+    let mut group = c.benchmark_group("loss");
     group.sample_size(10);
     for faces in [5_000usize, 10_000] {
         let (positions, triangles) = homer.source(faces);

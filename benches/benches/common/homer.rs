@@ -1,8 +1,9 @@
 //! The loss benches' fixture, shared by `benches/loss.rs` and `examples/loss_once.rs`:
 //! `$ROAR_TEST_DATA/clean/homer.obj` (12,000 faces, closed) prepared as a run prepares a soup
-//! (cleaned target, renders of the full and the coarse rig, point cloud), and sources made
-//! from it: decimated by QEM and shrunk by 2 % about the rig's centre, so that both terms have
-//! work to do (silhouettes off the target's, planar moves of about 1 % of the radius).
+//! (cleaned target, renders of the paper's full rig and of the soup schedule's coarse rig,
+//! point cloud), and sources made from it: decimated by QEM and shrunk by 2 % about the rig's
+//! centre, so that both terms have work to do (silhouettes off the target's, planar moves of
+//! about 1 % of the radius).
 
 use std::path::PathBuf;
 
@@ -16,7 +17,8 @@ use roar_render::{Camera, Image};
 /// The mesh, relative to `ROAR_TEST_DATA`.
 pub const MESH: &str = "clean/homer.obj";
 
-/// The prepared target of [`MESH`] at the default config.
+/// The prepared target of [`MESH`]: the full rig is the paper's (36 × 512², as the SDF and
+/// scan schedules render it), the coarse rig and the rest the default (soup) config's.
 pub struct Homer {
     pub config: ReconstructConfig,
     pub target: Target,
@@ -35,7 +37,8 @@ impl Homer {
         let soup = roar_io::read_mesh(&path)
             .unwrap_or_else(|e| panic!("cannot read {}: {e}", path.display()));
         let config = ReconstructConfig::default();
-        let target = build_target(&soup.positions, &soup.triangles, &target_options(&config))
+        let full_rig = target_options(&ReconstructConfig::sdf_defaults());
+        let target = build_target(&soup.positions, &soup.triangles, &full_rig)
             .expect("target of the bench mesh");
         let coarse_cameras = coarse_rig_cameras(&config);
         let coarse_renders =

@@ -46,7 +46,7 @@ pub struct CoarseViews {
 
 impl RenderLoss {
     /// The paper's render loss against a target: its cameras and renders, source culling off,
-    /// antialiasing on, L1. Clones the renders (36 × 512² × 16 B ≈ 151 MB at the defaults);
+    /// antialiasing on, L1. Clones the renders (36 × 512² × 16 B ≈ 151 MB on the paper's rig);
     /// to avoid the copy, build the struct directly with `std::mem::take(&mut target.renders)`.
     pub fn new(target: &Target) -> Self {
         Self::from_renders(&target.cameras, &target.renders)

@@ -76,7 +76,7 @@ pub trait Shape {
     /// Set-up before any other call, for the pipeline's camera rig (the same `cameras` are later
     /// passed to [`Shape::target_renders`]). The default does nothing. A soup welds, normalizes
     /// and cleans itself up here (renders from its own clean-up rig, then the target renders):
-    /// the costliest step of a shape, seconds at the default 36 views of 512².
+    /// the costliest step of a shape, seconds at the rig's 25–36 views of 512².
     fn prepare(&mut self, cameras: &[Camera]) -> Result<(), ShapeError> {
         let _ = cameras;
         Ok(())

@@ -12,7 +12,7 @@
 //!    back-face culling, and sum each face's visible pixels over the views;
 //! 6. per twin pair with counts `hi ≥ lo`, drop the lower twin only when `hi/(lo+1) ≥ ratio`
 //!    (80); ties and "undecided" pairs keep both twins;
-//! 7. render the 36 target normal maps of T′ (culling on, so
+//! 7. render the target normal maps of T′, one per view (culling on, so
 //!    the two twins of an undecided pair never z-fight).
 
 use std::collections::HashMap;

@@ -130,7 +130,7 @@ pub fn star_projection() -> DMat4 {
     )
 }
 
-/// The star rig of spec §3.2.1: `n_az × n_pol` cameras (default 6 × 6 = 36), index
+/// The star rig of spec §3.2.1: `n_az × n_pol` cameras (the spec's 6 × 6 = 36), index
 /// `a · n_pol + p`, with azimuth `φ_a = a·2π/n_az` about world y, polar angle
 /// `θ_p = (p+1)·π/(n_pol+1) − π/2` about x, view `T(0,0,−10)·R_x(θ_p)·R_y(φ_a)`, and the
 /// frustum of [`star_projection`].
