@@ -9,7 +9,7 @@
 # Defaults: the Stanford bunny beside the repo (../shared/data/scans/stanford-bunny/bun.conf and
 # its bun_zipper.ply), budgets 1000 and 5000, DIR target/compare-scans. The peers run on the
 # aligned patches `roar scans` writes (the same poses roar reconstructs from). PyMeshLab goes into
-# the virtualenv target/eval-venv (shared with scripts/evaluate.sh), made on first use.
+# the virtualenv target/eval-venv (scripts/eval_venv.sh), made on first use.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 repo="$(pwd)"
@@ -44,13 +44,8 @@ echo "== building roar (release)" >&2
 cargo build --release -q -p roar-cli
 roar="$repo/target/release/roar"
 
-venv="$repo/target/eval-venv"
-if ! "$venv/bin/python" -c "import pymeshlab, numpy" 2>/dev/null; then
-  echo "== installing PyMeshLab into $venv (once)" >&2
-  python3 -m venv "$venv"
-  "$venv/bin/pip" install -q --disable-pip-version-check pymeshlab point-cloud-utils numpy scipy trimesh
-fi
+python="$(scripts/eval_venv.sh)"
 
 mkdir -p "$out"
-exec "$venv/bin/python" "$repo/scripts/compare_scans.py" --roar "$roar" --set "$set_path" \
+exec "$python" "$repo/scripts/compare_scans.py" --roar "$roar" --set "$set_path" \
   --ref "$ref" --budgets $budgets --out "$out" --peers "$repo/scripts/peers.py"

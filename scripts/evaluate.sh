@@ -53,19 +53,14 @@ echo "== building roar (release)" >&2
 cargo build --release -q -p roar-cli
 roar="$repo/target/release/roar"
 
-venv="$repo/target/eval-venv"
-if ! "$venv/bin/python" -c "import pymeshlab, point_cloud_utils, numpy, scipy, trimesh" 2>/dev/null; then
-  echo "== installing the peers into $venv (once; about 2 minutes)" >&2
-  python3 -m venv "$venv"
-  "$venv/bin/pip" install -q --disable-pip-version-check pymeshlab point-cloud-utils numpy scipy trimesh
-fi
+python="$(scripts/eval_venv.sh)"
 
 mkdir -p "$out"
-args=(--roar "$roar" --python "$venv/bin/python" --data "$data" --meshes "$meshes"
+args=(--roar "$roar" --python "$python" --data "$data" --meshes "$meshes"
       --budgets "$budgets" --samples "$samples" --timeout "$timeout" --methods "$methods"
       --out "$out")
 args+=("${keep_from[@]}")
 if [ -n "$iterations" ]; then
   args+=(--iterations "$iterations")
 fi
-exec "$venv/bin/python" "$repo/scripts/evaluate.py" "${args[@]}"
+exec "$python" "$repo/scripts/evaluate.py" "${args[@]}"

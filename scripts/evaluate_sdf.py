@@ -6,6 +6,7 @@ OUT/results.json."""
 import argparse
 import json
 import os
+import subprocess
 import sys
 
 from roar_runs import evaluate, timed
@@ -31,6 +32,41 @@ def extract(roar, field, mesh, resolution, bounds):
     return line
 
 
+def meshlab_rows(a, name, resolution, grid, info, ref):
+    """The rows of one extraction decimated by MeshLab's QEM instead of roar's: `peers.py qem`
+    (topology-preserving quadric edge collapse) run by the `--meshlab` python, once for every
+    budget the grid reaches."""
+    method = "marching tetrahedra %d³ + MeshLab QEM" % resolution
+    budgets = [n for n in a.budgets if info["faces"] >= n]
+    result = {"budgets": {}}
+    if budgets:
+        peers = os.path.join(os.path.dirname(os.path.abspath(__file__)), "peers.py")
+        outdir = os.path.join(a.out, "%s-mt-%d-meshlab" % (name, resolution))
+        cmd = [a.meshlab, peers, "qem", grid, outdir, "--budgets"] + [str(n) for n in budgets]
+        proc = subprocess.run(cmd, capture_output=True, text=True)
+        if proc.returncode == 0:
+            result = json.loads(proc.stdout.strip().splitlines()[-1])
+        else:
+            failure = (proc.stderr.strip() or "failed").splitlines()[-1]
+            result["budgets"] = {str(n): {"error": failure} for n in budgets}
+    rows = []
+    for n in a.budgets:
+        row = {"field": name, "method": method, "budget": n,
+               "values": info["values"], "gradients": info["gradients"]}
+        entry = result["budgets"].get(str(n))
+        if entry is None:
+            row["error"] = "the grid gives %d faces, under the budget" % info["faces"]
+        elif "error" in entry:
+            row["error"] = entry["error"]
+        else:
+            row["seconds"] = info["seconds"] + entry["qem_seconds"]
+            row["peak_bytes"] = max(info["peak_bytes"] or 0, result.get("peak_bytes") or 0)
+            row.update(evaluate(a.roar, entry["output"], ref, a.samples))
+        print(row, file=sys.stderr)
+        rows.append(row)
+    return rows
+
+
 def main():
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--roar", required=True)
@@ -41,6 +77,7 @@ def main():
     p.add_argument("--config", default="")
     p.add_argument("--bounds", default="")
     p.add_argument("--samples", type=int, required=True)
+    p.add_argument("--meshlab", default="", help="a python with pymeshlab: adds MeshLab QEM rows")
     p.add_argument("--out", required=True)
     a = p.parse_args()
     rows = []
@@ -101,6 +138,8 @@ def main():
                         row.update(evaluate(a.roar, mesh, ref, a.samples))
                 print(row, file=sys.stderr)
                 rows.append(row)
+            if a.meshlab:
+                rows += meshlab_rows(a, name, r, grid, info, ref)
     with open(os.path.join(a.out, "results.json"), "w") as f:
         json.dump(rows, f, indent=1)
     lines = ["| field | method | N | SDF values | SDF gradients | seconds | peak GB | closed | genus "

@@ -8,13 +8,15 @@
 #
 #   scripts/evaluate_sdf.sh [--fields "A.npz B.npz"] [--budgets "5000 50000"]
 #       [--resolutions "32 64 128 256 512"] [--reference 512] [--samples 1000000] [--config FILE]
-#       [--out DIR]
+#       [--meshlab] [--out DIR]
 #
 # Defaults: the two shared networks (../shared/data/sdf/nif-bunny.npz, nif-hammer.npz), budgets
 # 5000 and 50000, resolutions 32 to 512, reference 512, 1,000,000 samples per side for Chamfer (at
 # 50,000 faces 200,000 samples put a floor under the figures that hides the differences), DIR
 # target/evaluate-sdf; roar with the SDF schedule's defaults unless --config gives a file of
 # overrides. Extractions are kept (MESH.obj.json) and roar runs resumed. Needs python3 (no packages).
+# --meshlab adds, for every extraction, rows decimated by MeshLab's QEM instead of roar's
+# (scripts/peers.py qem, in the virtualenv target/eval-venv that scripts/eval_venv.sh makes).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 repo="$(pwd)"
@@ -26,6 +28,7 @@ resolutions="32 64 128 256 512"
 reference=512
 samples=1000000
 config=""
+meshlab=""
 out="target/evaluate-sdf"
 while [ $# -gt 0 ]; do
   case "$1" in
@@ -35,8 +38,9 @@ while [ $# -gt 0 ]; do
     --reference) reference="$2"; shift 2 ;;
     --samples) samples="$2"; shift 2 ;;
     --config) config="$2"; shift 2 ;;
+    --meshlab) meshlab=1; shift ;;
     --out) out="$2"; shift 2 ;;
-    -h|--help) sed -n '2,17p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    -h|--help) sed -n '2,19p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
     *) echo "evaluate_sdf.sh: unknown argument $1" >&2; exit 2 ;;
   esac
 done
@@ -47,9 +51,14 @@ for f in $fields; do
   fi
 done
 
+python_args=()
+if [ -n "$meshlab" ]; then
+  python_args=(--meshlab "$(scripts/eval_venv.sh)")
+fi
+
 echo "== building roar (release)" >&2
 cargo build --release -q -p roar-cli
 mkdir -p "$out"
 exec python3 "$repo/scripts/evaluate_sdf.py" --roar "$repo/target/release/roar" --fields $fields \
   --budgets $budgets --resolutions $resolutions --reference "$reference" --samples "$samples" --config "$config" \
-  --out "$out"
+  "${python_args[@]}" --out "$out"
