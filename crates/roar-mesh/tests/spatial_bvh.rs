@@ -186,6 +186,9 @@ fn check_against_brute_force(
         }
     }
     assert_eq!(pairs, expected);
+    let mut parallel = bvh.overlapping_pairs_parallel();
+    parallel.sort();
+    assert_eq!(parallel, expected);
 }
 
 proptest! {
@@ -256,4 +259,35 @@ fn out_of_range_and_empty_inputs_do_not_crash() {
     assert!(empty.closest_point(DVec3::Z).is_none());
     assert!(empty.ray_cast(DVec3::Z, -DVec3::Z, 1.0).is_none());
     empty.overlapping_pairs(|_, _| panic!("no pairs in an empty tree"));
+}
+
+/// On a tree deep enough to be split over many tasks, the parallel pair search finds the serial
+/// one's pairs, each once, in an order that does not depend on the thread count.
+#[test]
+fn parallel_pairs_match_the_serial_ones_for_any_thread_count() {
+    // Two icospheres 1 % apart (10,240 faces): each face overlaps its neighbours and the faces
+    // across the gap.
+    let (inner, shell) = roar_mesh::shapes::icosphere(4).to_triangles();
+    let mut positions = inner.clone();
+    positions.extend(inner.iter().map(|p| *p * 1.01));
+    let offset = inner.len() as u32;
+    let mut triangles = shell.clone();
+    triangles.extend(shell.iter().map(|f| f.map(|i| i + offset)));
+    let bvh = TriangleBvh::build(&positions, &triangles);
+    let mut serial = Vec::new();
+    bvh.overlapping_pairs(|i, j| serial.push((i, j)));
+    serial.sort();
+    assert!(serial.len() > 6 * triangles.len(), "{} pairs", serial.len());
+    let run = |threads: usize| {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        pool.install(|| bvh.overlapping_pairs_parallel())
+    };
+    let one = run(1);
+    assert_eq!(one, run(3));
+    let mut sorted = one;
+    sorted.sort();
+    assert_eq!(sorted, serial);
 }

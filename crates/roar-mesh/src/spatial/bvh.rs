@@ -6,10 +6,12 @@
 //!
 //! Built with a binned surface-area heuristic over face centroids (median split when the
 //! centroids cannot be separated). The tree owns copies of the buffers, so queries take only
-//! the query geometry; [`TriangleBvh::refit`] updates it after vertices moved. All traversals
-//! are sequential and visit nodes in a fixed order, so every answer is deterministic.
+//! the query geometry; [`TriangleBvh::refit`] updates it after vertices moved. Every traversal
+//! visits nodes in a fixed order (the parallel pair search splits its walk in a fixed way), so
+//! every answer is deterministic, whatever the thread count.
 
 use glam::DVec3;
+use rayon::prelude::*;
 
 use super::aabb::Aabb;
 use super::point_triangle::{closest_point_on_triangle, ray_triangle};
@@ -19,6 +21,9 @@ pub const MAX_LEAF_FACES: usize = 4;
 
 /// Number of SAH bins per axis.
 const BIN_COUNT: usize = 16;
+
+/// Node pairs [`TriangleBvh::overlapping_pairs_parallel`] unfolds before it hands them to threads.
+const PARALLEL_PAIR_TASKS: usize = 64;
 
 /// The closest surface point found by [`TriangleBvh::closest_point`].
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -429,58 +434,103 @@ impl TriangleBvh {
         if self.nodes.is_empty() {
             return;
         }
+        let mut stack: Vec<(u32, u32)> = vec![(0, 0)];
+        while let Some(task) = stack.pop() {
+            self.pair_step(task, &mut stack, &mut visit);
+        }
+    }
+
+    /// The pairs of [`TriangleBvh::overlapping_pairs`], as `(i, j)` with `i < j`, found in
+    /// parallel: the top of the traversal is unfolded breadth first into at least
+    /// [`PARALLEL_PAIR_TASKS`] node pairs, which rayon's threads then walk depth first. The
+    /// order is fixed (the unfolding's own pairs, then each task's in task order), whatever
+    /// the thread count; it is not the order of `overlapping_pairs`.
+    pub fn overlapping_pairs_parallel(&self) -> Vec<(u32, u32)> {
+        if self.nodes.is_empty() {
+            return Vec::new();
+        }
+        let mut pairs = Vec::new();
+        let mut tasks = vec![(0, 0)];
+        while !tasks.is_empty() && tasks.len() < PARALLEL_PAIR_TASKS {
+            let mut next = Vec::with_capacity(4 * tasks.len());
+            for &task in &tasks {
+                self.pair_step(task, &mut next, &mut |i, j| pairs.push((i, j)));
+            }
+            tasks = next;
+        }
+        let found: Vec<Vec<(u32, u32)>> = tasks
+            .par_iter()
+            .map(|&task| {
+                let mut found = Vec::new();
+                let mut stack = vec![task];
+                while let Some(task) = stack.pop() {
+                    self.pair_step(task, &mut stack, &mut |i, j| found.push((i, j)));
+                }
+                found
+            })
+            .collect();
+        pairs.extend(found.into_iter().flatten());
+        pairs
+    }
+
+    /// One step of the pair traversal: node pair `(a, b)` (`a == b` for the pairs within one
+    /// node) either reports its leaves' overlapping face pairs or pushes the node pairs it
+    /// opens into (in the order a stack pops them left first).
+    fn pair_step(
+        &self,
+        (a, b): (u32, u32),
+        tasks: &mut Vec<(u32, u32)>,
+        visit: &mut impl FnMut(u32, u32),
+    ) {
         let mut emit = |f: u32, g: u32| {
             if self.face_aabb(f).overlaps(&self.face_aabb(g)) {
                 visit(f.min(g), f.max(g));
             }
         };
-        let mut stack: Vec<(u32, u32)> = vec![(0, 0)];
-        while let Some((a, b)) = stack.pop() {
-            let (na, nb) = (&self.nodes[a as usize], &self.nodes[b as usize]);
-            if a == b {
-                if na.is_leaf() {
-                    let faces = self.leaf_faces(na);
-                    for i in 0..faces.len() {
-                        for j in i + 1..faces.len() {
-                            emit(faces[i], faces[j]);
-                        }
+        let (na, nb) = (&self.nodes[a as usize], &self.nodes[b as usize]);
+        if a == b {
+            if na.is_leaf() {
+                let faces = self.leaf_faces(na);
+                for i in 0..faces.len() {
+                    for j in i + 1..faces.len() {
+                        emit(faces[i], faces[j]);
                     }
+                }
+            } else {
+                let (l, r) = (na.start, na.start + 1);
+                tasks.push((l, r));
+                tasks.push((r, r));
+                tasks.push((l, l));
+            }
+            return;
+        }
+        if !na.aabb.overlaps(&nb.aabb) {
+            return;
+        }
+        match (na.is_leaf(), nb.is_leaf()) {
+            (true, true) => {
+                for &f in self.leaf_faces(na) {
+                    for &g in self.leaf_faces(nb) {
+                        emit(f, g);
+                    }
+                }
+            }
+            (false, true) => {
+                tasks.push((na.start + 1, b));
+                tasks.push((na.start, b));
+            }
+            (true, false) => {
+                tasks.push((a, nb.start + 1));
+                tasks.push((a, nb.start));
+            }
+            (false, false) => {
+                // Open the larger box.
+                if na.aabb.half_area() >= nb.aabb.half_area() {
+                    tasks.push((na.start + 1, b));
+                    tasks.push((na.start, b));
                 } else {
-                    let (l, r) = (na.start, na.start + 1);
-                    stack.push((l, r));
-                    stack.push((r, r));
-                    stack.push((l, l));
-                }
-                continue;
-            }
-            if !na.aabb.overlaps(&nb.aabb) {
-                continue;
-            }
-            match (na.is_leaf(), nb.is_leaf()) {
-                (true, true) => {
-                    for &f in self.leaf_faces(na) {
-                        for &g in self.leaf_faces(nb) {
-                            emit(f, g);
-                        }
-                    }
-                }
-                (false, true) => {
-                    stack.push((na.start + 1, b));
-                    stack.push((na.start, b));
-                }
-                (true, false) => {
-                    stack.push((a, nb.start + 1));
-                    stack.push((a, nb.start));
-                }
-                (false, false) => {
-                    // Open the larger box.
-                    if na.aabb.half_area() >= nb.aabb.half_area() {
-                        stack.push((na.start + 1, b));
-                        stack.push((na.start, b));
-                    } else {
-                        stack.push((a, nb.start + 1));
-                        stack.push((a, nb.start));
-                    }
+                    tasks.push((a, nb.start + 1));
+                    tasks.push((a, nb.start));
                 }
             }
         }

@@ -54,11 +54,11 @@ pub struct LimiterStats {
 /// old and proposed corners). The pairs of overlapping swept boxes ([`swept_candidates`]) are
 /// therefore all the pairs a pass may need; a pass keeps those whose current boxes overlap.
 ///
-/// Cost: one BVH build over the swept boxes, then per pass, for the changed faces, a walk over
-/// their candidates and the exact tests (most pairs are settled by `certainly_apart`, the rest
-/// by `roar_mesh::spatial::faces_intersect_filtered`), spread over rayon's threads. Invalid
-/// indices are ignored, and so are faces with a non-finite old corner; non-finite proposals are
-/// cancelled.
+/// Cost: one BVH build and pair search over the swept boxes, then per pass, for the changed
+/// faces, a walk over their candidates and the exact tests (most pairs are settled by
+/// `certainly_apart`, the rest by `roar_mesh::spatial::faces_intersect_filtered`), all spread
+/// over rayon's threads. Invalid indices are ignored, and so are faces with a non-finite old
+/// corner; non-finite proposals are cancelled.
 pub fn limit_steps(
     before: &[DVec3],
     proposed: &mut [DVec3],
@@ -260,7 +260,8 @@ impl Candidates {
 /// swept box (the box of its `before` and `proposed` corners) overlaps its own, keeping only
 /// pairs with a changed face (a corner with `halvings != u32::MAX`). The boxes go into a
 /// [`TriangleBvh`] as degenerate triangles `(min, max, max)`, whose boxes are exactly them,
-/// and [`TriangleBvh::overlapping_pairs`] lists the overlapping ones.
+/// and [`TriangleBvh::overlapping_pairs_parallel`] lists the overlapping ones (their order
+/// does not matter: a pass's result depends only on which pairs intersect).
 fn swept_candidates(
     before: &[DVec3],
     proposed: &[DVec3],
@@ -287,12 +288,8 @@ fn swept_candidates(
             .iter()
             .any(|&i| halvings[i as usize] != u32::MAX)
     };
-    let mut pairs: Vec<(u32, u32)> = Vec::new();
-    tree.overlapping_pairs(|f, g| {
-        if changed(f) || changed(g) {
-            pairs.push((f, g));
-        }
-    });
+    let mut pairs = tree.overlapping_pairs_parallel();
+    pairs.retain(|&(f, g)| changed(f) || changed(g));
     let mut offsets = vec![0usize; triangles.len() + 1];
     for &(f, g) in &pairs {
         offsets[f as usize + 1] += 1;
