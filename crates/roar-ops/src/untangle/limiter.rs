@@ -56,9 +56,10 @@ pub struct LimiterStats {
 ///
 /// Cost: one BVH build and pair search over the swept boxes, then per pass, for the changed
 /// faces, a walk over their candidates and the exact tests (most pairs are settled by
-/// `certainly_apart`, the rest by `roar_mesh::spatial::faces_intersect_filtered`), all spread
-/// over rayon's threads. Invalid indices are ignored, and so are faces with a non-finite old
-/// corner; non-finite proposals are cancelled.
+/// `certainly_apart`, the rest by `roar_mesh::spatial::faces_intersect_filtered`). The pair
+/// search and the tests run on rayon's threads; the bookkeeping between them (candidate rows,
+/// dirty faces, shortening) runs on one. Invalid indices are ignored, and so are faces with a
+/// non-finite old corner; non-finite proposals are cancelled.
 pub fn limit_steps(
     before: &[DVec3],
     proposed: &mut [DVec3],
