@@ -15,7 +15,7 @@ use roar_ops::blocks::smoothing::SmoothingOptions;
 use roar_ops::decimate::{DecimateOptions, DecimateStats, decimate};
 use roar_ops::finish::data_flips::{DataFlipOptions, flip_toward_target};
 use roar_ops::finish::degenerate::{DegenerateOptions, collapse_degenerate_faces};
-use roar_ops::finish::fill::fill_to_budget;
+use roar_ops::finish::fill::{fill_to_budget, fill_to_budget_on_field};
 use roar_ops::finish::fins::{FinOptions, collapse_fins};
 use roar_ops::finish::genus::{HandleRemovalOptions, decimate_removing_handles, remove_handles};
 use roar_ops::finish::offset::offset_outward;
@@ -46,7 +46,7 @@ pub(super) fn finish(
         run.stats.optimize.loss_last,
         faces,
     )?;
-    let mut mesh = finish_from_best_state(states, config, &mut run.stats)?;
+    let mut mesh = finish_from_best_state(states, field, config, &mut run.stats)?;
     run.clock.lap("untangle");
 
     run.report(
@@ -116,6 +116,7 @@ pub(super) fn finish(
 /// clears.
 fn finish_from_best_state(
     mut states: Vec<LoopState>,
+    field: Option<&dyn Sdf>,
     config: &ReconstructConfig,
     stats: &mut RunStats,
 ) -> Result<Mesh, PipelineError> {
@@ -127,7 +128,7 @@ fn finish_from_best_state(
     let mut unresolved = 0;
     for state in states {
         let mut mesh = state.mesh;
-        unresolved = fill_and_untangle(&mut mesh, config, stats);
+        unresolved = fill_and_untangle(&mut mesh, field, config, stats);
         if unresolved == 0 {
             stats.optimize.finished_from_iteration = state.iteration;
             return Ok(mesh);
@@ -143,12 +144,31 @@ fn finish_from_best_state(
 /// Fills the mesh up to `config.faces`, runs the untangle block and fills again (its collapses
 /// may take the mesh below the budget, and the final QEM never adds faces; splits do not move
 /// any geometry, so no intersection comes back). Returns how many faces it could not clear.
-fn fill_and_untangle(mesh: &mut Mesh, config: &ReconstructConfig, stats: &mut RunStats) -> usize {
-    stats.finish.fill_splits = fill_to_budget(mesh, config.faces);
+fn fill_and_untangle(
+    mesh: &mut Mesh,
+    field: Option<&dyn Sdf>,
+    config: &ReconstructConfig,
+    stats: &mut RunStats,
+) -> usize {
+    stats.finish.fill_splits = fill(mesh, config.faces, field, config);
     let untangled = untangle(mesh, &untangle_options(config));
     record_untangle(stats, &untangled);
-    stats.finish.fill_splits += fill_to_budget(mesh, config.faces);
+    stats.finish.fill_splits += fill(mesh, config.faces, field, config);
     untangled.unresolved_faces.len()
+}
+
+/// The fill to `faces`: on a field, where the chords stray farthest from its zero set first
+/// (`fill_to_budget_on_field`), otherwise longest edge first.
+fn fill(
+    mesh: &mut Mesh,
+    faces: usize,
+    field: Option<&dyn Sdf>,
+    config: &ReconstructConfig,
+) -> usize {
+    match field {
+        Some(field) => fill_to_budget_on_field(mesh, faces, field, config.loss.sdf_loss_epsilon),
+        None => fill_to_budget(mesh, faces),
+    }
 }
 
 /// The untangle block's options under `config` (its separation margin).
@@ -359,7 +379,7 @@ fn fit_to_zero_set_if_clean(
         if fin_options.max_distance_over_edge > 0.0 {
             let faces = moved.n_faces();
             collapsed = collapse_fins(moved, field, &fin_options).accepted;
-            fill_to_budget(moved, faces);
+            fill(moved, faces, Some(field), config);
         }
         if fit_options.steps > 0 {
             fit = fit_to_zero_set(moved, field, &fit_options);
@@ -609,7 +629,7 @@ mod tests {
             ..ReconstructConfig::default()
         };
         let mut stats = RunStats::default();
-        let unresolved = fill_and_untangle(&mut mesh, &config, &mut stats);
+        let unresolved = fill_and_untangle(&mut mesh, None, &config, &mut stats);
         assert_eq!(unresolved, 0);
         // The mesh started at the budget, so every split refilled a face the untangle removed.
         assert!(stats.finish.untangle_initial_pairs > 0);
@@ -681,7 +701,7 @@ mod tests {
             ..ReconstructConfig::default()
         };
         let mut stats = RunStats::default();
-        let mesh = finish_from_best_state(states, &config, &mut stats).unwrap();
+        let mesh = finish_from_best_state(states, None, &config, &mut stats).unwrap();
         assert_eq!(stats.optimize.untangle_failures.len(), 1);
         assert_eq!(stats.optimize.untangle_failures[0].iteration, 10);
         assert!(stats.optimize.untangle_failures[0].unresolved_faces > 0);

@@ -2,10 +2,11 @@
 //! block's and the degenerate collapses' removals. Splits move no geometry, so no
 //! self-intersection can appear.
 
+use glam::DVec3;
+use roar_mesh::spatial::{Sdf, evaluate_with_gradients, triangle_quality};
 use roar_mesh::{EdgeId, Mesh};
 
 use crate::geometry::{DEGENERATE_QUALITY, is_degenerate};
-use roar_mesh::spatial::triangle_quality;
 
 /// Splits edges at their midpoints until the mesh has `faces` faces (each split adds two),
 /// longest first, skipping edges whose halving would leave a degenerate face
@@ -14,20 +15,79 @@ use roar_mesh::spatial::triangle_quality;
 /// follows. When no edge qualifies the longest is split anyway, so the fill always ends. The
 /// geometry does not change, so no intersection can appear. Returns the split count.
 pub fn fill_to_budget(mesh: &mut Mesh, faces: usize) -> usize {
+    fill_in_rounds(mesh, faces, 1.0, |mesh, edges| {
+        edges.iter().map(|&e| mesh.edge_length(e)).collect()
+    })
+}
+
+/// [`fill_to_budget`] on a field: the edges along which the surface curves farthest away from
+/// the chord are split first, in rounds that each split at most a quarter of the edges and
+/// then judge the new ones. An edge's gap is `|s(m) − (s(a) + s(b))/2|`, `s` the signed
+/// first-order distance `f/(|∇f| + epsilon)` of `sdf` and `m` the midpoint of `(a, b)`: the
+/// chord's sagitta, whether or not its ends lie on the zero set (the splits' new vertices lie
+/// on chords until the fit to the zero set moves them). Longest first would subdivide flat and
+/// curved parts alike; this puts the faces where the surface bends, as a QEM of a fine
+/// extraction does.
+pub fn fill_to_budget_on_field(
+    mesh: &mut Mesh,
+    faces: usize,
+    sdf: &dyn Sdf,
+    epsilon: f64,
+) -> usize {
+    let signed_distances = |points: &[DVec3]| -> Vec<f64> {
+        let (values, gradients) = evaluate_with_gradients(sdf, points);
+        values
+            .iter()
+            .zip(&gradients)
+            .map(|(f, g)| f / (g.length() + epsilon))
+            .collect()
+    };
+    fill_in_rounds(mesh, faces, 0.25, |mesh, edges| {
+        let ends: Vec<[roar_mesh::VertexId; 2]> =
+            edges.iter().map(|&e| mesh.edge_vertices(e)).collect();
+        let mut points: Vec<DVec3> = mesh.vertices().map(|v| mesh.position(v)).collect();
+        let vertex_slot: std::collections::HashMap<_, _> =
+            mesh.vertices().enumerate().map(|(i, v)| (v, i)).collect();
+        points.extend(
+            ends.iter()
+                .map(|&[a, b]| 0.5 * (mesh.position(a) + mesh.position(b))),
+        );
+        let s = signed_distances(&points);
+        let at_midpoints = &s[vertex_slot.len()..];
+        ends.iter()
+            .zip(at_midpoints)
+            .map(|(&[a, b], &m)| {
+                let gap = (m - 0.5 * (s[vertex_slot[&a]] + s[vertex_slot[&b]])).abs();
+                if gap.is_finite() { gap } else { 0.0 }
+            })
+            .collect()
+    })
+}
+
+/// The fill's rounds: each ranks the edges that [`bisects_well`] (all edges when none does) by
+/// `priority`, highest first, ties by id, and splits as many as the budget still wants, at
+/// most `fraction` of them (at least one).
+fn fill_in_rounds(
+    mesh: &mut Mesh,
+    faces: usize,
+    fraction: f64,
+    mut priority: impl FnMut(&Mesh, &[EdgeId]) -> Vec<f64>,
+) -> usize {
     let mut splits = 0;
     while mesh.n_faces() < faces {
-        let mut edges: Vec<(f64, EdgeId)> = mesh
-            .edges()
-            .filter(|&e| bisects_well(mesh, e))
-            .map(|e| (mesh.edge_length(e), e))
-            .collect();
-        if edges.is_empty() {
-            edges = mesh.edges().map(|e| (mesh.edge_length(e), e)).collect();
+        let mut candidates: Vec<EdgeId> = mesh.edges().filter(|&e| bisects_well(mesh, e)).collect();
+        if candidates.is_empty() {
+            candidates = mesh.edges().collect();
         }
-        // Longest first; ties by id keep it deterministic.
+        let mut edges: Vec<(f64, EdgeId)> = priority(mesh, &candidates)
+            .into_iter()
+            .zip(candidates)
+            .collect();
         edges.sort_by(|a, b| b.0.total_cmp(&a.0).then(a.1.cmp(&b.1)));
-        let wanted = (faces - mesh.n_faces()) / 2;
-        for &(_, e) in edges.iter().take(wanted.max(1)) {
+        let wanted = ((faces - mesh.n_faces()) / 2)
+            .min((fraction * edges.len() as f64).ceil() as usize)
+            .max(1);
+        for &(_, e) in edges.iter().take(wanted) {
             if mesh.n_faces() >= faces {
                 break;
             }
@@ -51,4 +111,86 @@ pub fn bisects_well(mesh: &Mesh, e: EdgeId) -> bool {
             .into_iter()
             .all(|t| !is_degenerate(triangle_quality(t), DEGENERATE_QUALITY))
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use roar_mesh::shapes::icosphere;
+    use roar_mesh::spatial::{FnSdf, project_to_zero_set};
+
+    /// An icosphere stretched threefold along x: its vertices lie on the ellipsoid
+    /// `(x/3)² + y² + z² = 1`, whose ends curve nine times more than its waist.
+    fn ellipsoid() -> (Mesh, FnSdf<impl Fn(DVec3) -> f64 + Send + Sync>) {
+        let mut mesh = icosphere(2);
+        let vertices: Vec<_> = mesh.vertices().collect();
+        for v in vertices {
+            let p = mesh.position(v);
+            mesh.set_position(v, DVec3::new(3.0 * p.x, p.y, p.z));
+        }
+        let field = FnSdf::new(|p: DVec3| DVec3::new(p.x / 3.0, p.y, p.z).length() - 1.0);
+        (mesh, field)
+    }
+
+    /// The largest first-order distance of an edge midpoint from the zero set of `field`.
+    fn largest_chord_gap(mesh: &Mesh, field: &dyn Sdf) -> f64 {
+        let edges: Vec<EdgeId> = mesh.edges().collect();
+        let midpoints: Vec<DVec3> = edges
+            .iter()
+            .map(|&e| {
+                let [a, b] = mesh.edge_vertices(e);
+                0.5 * (mesh.position(a) + mesh.position(b))
+            })
+            .collect();
+        let (values, gradients) = evaluate_with_gradients(field, &midpoints);
+        values
+            .iter()
+            .zip(&gradients)
+            .map(|(f, g)| f.abs() / g.length())
+            .fold(0.0, f64::max)
+    }
+
+    #[test]
+    fn both_fills_reach_the_budget_with_a_valid_mesh() {
+        let (mesh, field) = ellipsoid();
+        let budget = 4 * mesh.n_faces() + 2;
+        let mut by_length = mesh.clone();
+        let mut on_field = mesh.clone();
+        let splits = fill_to_budget(&mut by_length, budget);
+        let field_splits = fill_to_budget_on_field(&mut on_field, budget, &field, 1e-10);
+        for (filled, splits) in [(&by_length, splits), (&on_field, field_splits)] {
+            assert_eq!(filled.n_faces(), budget);
+            assert_eq!(splits, (budget - mesh.n_faces()) / 2);
+            filled.validate().unwrap();
+            assert_eq!(filled.genus(), 0);
+        }
+    }
+
+    #[test]
+    fn the_field_fill_splits_where_the_chords_stray_from_the_zero_set() {
+        let (mesh, field) = ellipsoid();
+        let budget = 4 * mesh.n_faces();
+        let mut by_length = mesh.clone();
+        let mut on_field = mesh.clone();
+        fill_to_budget(&mut by_length, budget);
+        fill_to_budget_on_field(&mut on_field, budget, &field, 1e-10);
+        // The finish fits the mesh to the zero set after the fill: here every vertex is put on
+        // it, so what is left of a gap is the chord's own.
+        for filled in [&mut by_length, &mut on_field] {
+            let vertices: Vec<_> = filled.vertices().collect();
+            let mut points: Vec<DVec3> = vertices.iter().map(|&v| filled.position(v)).collect();
+            project_to_zero_set(&field, &mut points, 20, 1e-12);
+            for (v, p) in vertices.into_iter().zip(points) {
+                filled.set_position(v, p);
+            }
+        }
+        let (length_gap, field_gap) = (
+            largest_chord_gap(&by_length, &field),
+            largest_chord_gap(&on_field, &field),
+        );
+        assert!(
+            field_gap < 0.7 * length_gap,
+            "largest chord gap: {field_gap:.3e} on the field, {length_gap:.3e} longest first"
+        );
+    }
 }
