@@ -141,34 +141,27 @@ fn finish_from_best_state(
     Err(PipelineError::Intersections(unresolved))
 }
 
-/// Fills the mesh up to `config.faces`, runs the untangle block and fills again (its collapses
-/// may take the mesh below the budget, and the final QEM never adds faces; splits do not move
-/// any geometry, so no intersection comes back). Returns how many faces it could not clear.
+/// Fills the mesh up to `config.faces` (on a field, where the chords stray farthest from its zero
+/// set first, the new vertices on it: `fill_to_budget_on_field`), runs the untangle block and
+/// fills again, longest edge first (its collapses may take the mesh below the budget, and the
+/// final QEM never adds faces; those splits move no geometry, so no intersection comes back).
+/// Returns how many faces it could not clear.
 fn fill_and_untangle(
     mesh: &mut Mesh,
     field: Option<&dyn Sdf>,
     config: &ReconstructConfig,
     stats: &mut RunStats,
 ) -> usize {
-    stats.finish.fill_splits = fill(mesh, config.faces, field, config);
+    stats.finish.fill_splits = match field {
+        Some(field) => {
+            fill_to_budget_on_field(mesh, config.faces, field, config.loss.sdf_loss_epsilon)
+        }
+        None => fill_to_budget(mesh, config.faces),
+    };
     let untangled = untangle(mesh, &untangle_options(config));
     record_untangle(stats, &untangled);
-    stats.finish.fill_splits += fill(mesh, config.faces, field, config);
+    stats.finish.fill_splits += fill_to_budget(mesh, config.faces);
     untangled.unresolved_faces.len()
-}
-
-/// The fill to `faces`: on a field, where the chords stray farthest from its zero set first
-/// (`fill_to_budget_on_field`), otherwise longest edge first.
-fn fill(
-    mesh: &mut Mesh,
-    faces: usize,
-    field: Option<&dyn Sdf>,
-    config: &ReconstructConfig,
-) -> usize {
-    match field {
-        Some(field) => fill_to_budget_on_field(mesh, faces, field, config.loss.sdf_loss_epsilon),
-        None => fill_to_budget(mesh, faces),
-    }
 }
 
 /// The untangle block's options under `config` (its separation margin).
@@ -379,7 +372,7 @@ fn fit_to_zero_set_if_clean(
         if fin_options.max_distance_over_edge > 0.0 {
             let faces = moved.n_faces();
             collapsed = collapse_fins(moved, field, &fin_options).accepted;
-            fill(moved, faces, Some(field), config);
+            fill_to_budget(moved, faces);
         }
         if fit_options.steps > 0 {
             fit = fit_to_zero_set(moved, field, &fit_options);

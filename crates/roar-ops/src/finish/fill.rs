@@ -2,9 +2,11 @@
 //! block's and the degenerate collapses' removals. Splits move no geometry, so no
 //! self-intersection can appear.
 
+use std::collections::HashMap;
+
 use glam::DVec3;
-use roar_mesh::spatial::{Sdf, evaluate_with_gradients, triangle_quality};
-use roar_mesh::{EdgeId, Mesh};
+use roar_mesh::spatial::{Sdf, evaluate_with_gradients, project_to_zero_set, triangle_quality};
+use roar_mesh::{EdgeId, EdgeSplit, Mesh, VertexId};
 
 use crate::geometry::{DEGENERATE_QUALITY, is_degenerate};
 
@@ -15,19 +17,28 @@ use crate::geometry::{DEGENERATE_QUALITY, is_degenerate};
 /// follows. When no edge qualifies the longest is split anyway, so the fill always ends. The
 /// geometry does not change, so no intersection can appear. Returns the split count.
 pub fn fill_to_budget(mesh: &mut Mesh, faces: usize) -> usize {
-    fill_in_rounds(mesh, faces, 1.0, |mesh, edges| {
-        edges.iter().map(|&e| mesh.edge_length(e)).collect()
-    })
+    fill_in_rounds(
+        mesh,
+        faces,
+        1.0,
+        |mesh, edges| edges.iter().map(|&e| mesh.edge_length(e)).collect(),
+        |_, _| {},
+    )
 }
 
 /// [`fill_to_budget`] on a field: the edges along which the surface curves farthest away from
 /// the chord are split first, in rounds that each split at most a quarter of the edges and
-/// then judge the new ones. An edge's gap is `|s(m) − (s(a) + s(b))/2|`, `s` the signed
-/// first-order distance `f/(|∇f| + epsilon)` of `sdf` and `m` the midpoint of `(a, b)`: the
-/// chord's sagitta, whether or not its ends lie on the zero set (the splits' new vertices lie
-/// on chords until the fit to the zero set moves them). Longest first would subdivide flat and
-/// curved parts alike; this puts the faces where the surface bends, as a QEM of a fine
-/// extraction does.
+/// then judge the new ones, and each new vertex is moved onto the zero set. An edge's gap is
+/// `|s(m) − (s(a) + s(b))/2|`, `s` the signed first-order distance `f/(|∇f| + epsilon)` of
+/// `sdf` and `m` the midpoint of `(a, b)`: the chord's sagitta. Longest first would subdivide
+/// flat and curved parts alike; this puts the faces where the surface bends, as a QEM of a fine
+/// extraction does. A new vertex left on its chord would stand off the surface by that sagitta,
+/// a large part of its short new edges where the surface bends sharply, so it takes up to three
+/// first-order steps onto the zero set, kept when they move it at most half the split edge's
+/// length in all.
+///
+/// Unlike [`fill_to_budget`] this moves geometry, so faces may come to intersect: call it where
+/// the untangle block follows.
 pub fn fill_to_budget_on_field(
     mesh: &mut Mesh,
     faces: usize,
@@ -42,36 +53,48 @@ pub fn fill_to_budget_on_field(
             .map(|(f, g)| f / (g.length() + epsilon))
             .collect()
     };
-    fill_in_rounds(mesh, faces, 0.25, |mesh, edges| {
-        let ends: Vec<[roar_mesh::VertexId; 2]> =
-            edges.iter().map(|&e| mesh.edge_vertices(e)).collect();
+    let priority = |mesh: &Mesh, edges: &[EdgeId]| -> Vec<f64> {
+        let ends: Vec<[VertexId; 2]> = edges.iter().map(|&e| mesh.edge_vertices(e)).collect();
         let mut points: Vec<DVec3> = mesh.vertices().map(|v| mesh.position(v)).collect();
-        let vertex_slot: std::collections::HashMap<_, _> =
+        let slot: HashMap<VertexId, usize> =
             mesh.vertices().enumerate().map(|(i, v)| (v, i)).collect();
         points.extend(
             ends.iter()
                 .map(|&[a, b]| 0.5 * (mesh.position(a) + mesh.position(b))),
         );
         let s = signed_distances(&points);
-        let at_midpoints = &s[vertex_slot.len()..];
+        let at_midpoints = &s[slot.len()..];
         ends.iter()
             .zip(at_midpoints)
             .map(|(&[a, b], &m)| {
-                let gap = (m - 0.5 * (s[vertex_slot[&a]] + s[vertex_slot[&b]])).abs();
+                let gap = (m - 0.5 * (s[slot[&a]] + s[slot[&b]])).abs();
                 if gap.is_finite() { gap } else { 0.0 }
             })
             .collect()
-    })
+    };
+    let onto_zero_set = |mesh: &mut Mesh, splits: &[EdgeSplit]| {
+        let start: Vec<DVec3> = splits.iter().map(|s| mesh.position(s.new_vertex)).collect();
+        let mut moved = start.clone();
+        project_to_zero_set(sdf, &mut moved, 3, epsilon);
+        for ((split, from), to) in splits.iter().zip(start).zip(moved) {
+            let [a, b] = split.parents.map(|v| mesh.position(v));
+            if to.is_finite() && from.distance(to) <= 0.5 * a.distance(b) {
+                mesh.set_position(split.new_vertex, to);
+            }
+        }
+    };
+    fill_in_rounds(mesh, faces, 0.25, priority, onto_zero_set)
 }
 
 /// The fill's rounds: each ranks the edges that [`bisects_well`] (all edges when none does) by
-/// `priority`, highest first, ties by id, and splits as many as the budget still wants, at
-/// most `fraction` of them (at least one).
+/// `priority`, highest first, ties by id, splits as many as the budget still wants, at most
+/// `fraction` of them (at least one), and hands the round's splits to `settle`.
 fn fill_in_rounds(
     mesh: &mut Mesh,
     faces: usize,
     fraction: f64,
     mut priority: impl FnMut(&Mesh, &[EdgeId]) -> Vec<f64>,
+    mut settle: impl FnMut(&mut Mesh, &[EdgeSplit]),
 ) -> usize {
     let mut splits = 0;
     while mesh.n_faces() < faces {
@@ -87,13 +110,15 @@ fn fill_in_rounds(
         let wanted = ((faces - mesh.n_faces()) / 2)
             .min((fraction * edges.len() as f64).ceil() as usize)
             .max(1);
+        let mut round = Vec::with_capacity(wanted);
         for &(_, e) in edges.iter().take(wanted) {
             if mesh.n_faces() >= faces {
                 break;
             }
-            mesh.split_edge(e, 0.5);
-            splits += 1;
+            round.push(mesh.split_edge(e, 0.5));
         }
+        splits += round.len();
+        settle(mesh, &round);
     }
     mesh.compact();
     splits
@@ -117,7 +142,7 @@ pub fn bisects_well(mesh: &Mesh, e: EdgeId) -> bool {
 mod tests {
     use super::*;
     use roar_mesh::shapes::icosphere;
-    use roar_mesh::spatial::{FnSdf, project_to_zero_set};
+    use roar_mesh::spatial::FnSdf;
 
     /// An icosphere stretched threefold along x: its vertices lie on the ellipsoid
     /// `(x/3)² + y² + z² = 1`, whose ends curve nine times more than its waist.
@@ -192,5 +217,20 @@ mod tests {
             field_gap < 0.7 * length_gap,
             "largest chord gap: {field_gap:.3e} on the field, {length_gap:.3e} longest first"
         );
+    }
+
+    #[test]
+    fn the_field_fill_puts_its_new_vertices_on_the_zero_set() {
+        let (mut mesh, field) = ellipsoid();
+        let budget = 4 * mesh.n_faces();
+        fill_to_budget_on_field(&mut mesh, budget, &field, 1e-10);
+        let points: Vec<DVec3> = mesh.vertices().map(|v| mesh.position(v)).collect();
+        let (values, gradients) = evaluate_with_gradients(&field, &points);
+        let farthest = values
+            .iter()
+            .zip(&gradients)
+            .map(|(f, g)| f.abs() / g.length())
+            .fold(0.0, f64::max);
+        assert!(farthest < 1e-6, "a vertex {farthest:.3e} off the zero set");
     }
 }
