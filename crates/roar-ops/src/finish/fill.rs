@@ -1,6 +1,7 @@
-//! The fill to a face budget by edge splits: the finish's way back up to N after the untangle
-//! block's and the degenerate collapses' removals. Splits move no geometry, so no
-//! self-intersection can appear.
+//! The fill to a face budget by edge splits: the finish's way up to N from a loop state below
+//! it and back up after the untangle block's and the degenerate collapses' removals. Longest
+//! first, splits move no geometry, so no self-intersection can appear; on a field, where the
+//! chords stray from the zero set first, with the new vertices moved onto it.
 
 use std::collections::HashMap;
 
