@@ -52,8 +52,8 @@ pub use regular_sampling::{
 };
 pub use sampling::{SurfaceSamples, sample_surface};
 pub use sdf::{
-    FnSdf, Sdf, SdfCounter, SdfEvaluations, evaluate_with_gradients, first_order_step,
-    project_to_zero_set,
+    FnSdf, Sdf, SdfCounter, SdfEvaluations, evaluate_with_gradients, first_order_distances,
+    first_order_step, project_to_zero_set,
 };
 pub use self_intersections::{
     count_intersecting_faces, face_intersects_any, intersecting_pairs, self_intersecting_faces,

@@ -113,6 +113,17 @@ pub fn first_order_step(f: f64, g: DVec3, epsilon: f64) -> DVec3 {
     -f * g / (g.length_squared() + epsilon)
 }
 
+/// The signed first-order distances `f/(|∇f| + ε)` of `sdf` at `points`: the distance to the
+/// zero set to first order, whatever the scale of the field.
+pub fn first_order_distances(sdf: &dyn Sdf, points: &[DVec3], epsilon: f64) -> Vec<f64> {
+    let (values, gradients) = evaluate_with_gradients(sdf, points);
+    values
+        .iter()
+        .zip(&gradients)
+        .map(|(f, g)| f / (g.length() + epsilon))
+        .collect()
+}
+
 /// Values and gradients of `sdf` at `points` in one call, as new vectors.
 pub fn evaluate_with_gradients(sdf: &dyn Sdf, points: &[DVec3]) -> (Vec<f64>, Vec<DVec3>) {
     let mut values = vec![0.0; points.len()];
@@ -188,6 +199,24 @@ mod tests {
                     values: 0,
                     gradients: 6
                 }
+            );
+        }
+    }
+
+    #[test]
+    fn first_order_distances_ignore_the_field_scale() {
+        let points = [DVec3::new(2.0, 0.0, 0.0), DVec3::new(0.1, 0.2, -0.3)];
+        for k in [1.0, 4000.0] {
+            let sdf = ScaledSphere {
+                k,
+                counter: SdfCounter::default(),
+            };
+            let d = first_order_distances(&sdf, &points, 1e-12);
+            assert!((d[0] - 1.0).abs() < 1e-9, "k {k}: {}", d[0]);
+            assert!(
+                (d[1] - (points[1].length() - 1.0)).abs() < 1e-9,
+                "k {k}: {}",
+                d[1]
             );
         }
     }

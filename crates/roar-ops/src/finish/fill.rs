@@ -3,10 +3,8 @@
 //! first, splits move no geometry, so no self-intersection can appear; on a field, where the
 //! chords stray from the zero set first, with the new vertices moved onto it.
 
-use std::collections::HashMap;
-
 use glam::DVec3;
-use roar_mesh::spatial::{Sdf, evaluate_with_gradients, project_to_zero_set, triangle_quality};
+use roar_mesh::spatial::{Sdf, first_order_distances, project_to_zero_set, triangle_quality};
 use roar_mesh::{EdgeId, EdgeSplit, Mesh, VertexId};
 
 use crate::geometry::{DEGENERATE_QUALITY, is_degenerate};
@@ -46,29 +44,26 @@ pub fn fill_to_budget_on_field(
     sdf: &dyn Sdf,
     epsilon: f64,
 ) -> usize {
-    let signed_distances = |points: &[DVec3]| -> Vec<f64> {
-        let (values, gradients) = evaluate_with_gradients(sdf, points);
-        values
-            .iter()
-            .zip(&gradients)
-            .map(|(f, g)| f / (g.length() + epsilon))
-            .collect()
-    };
     let priority = |mesh: &Mesh, edges: &[EdgeId]| -> Vec<f64> {
+        let vertices: Vec<VertexId> = mesh.vertices().collect();
         let ends: Vec<[VertexId; 2]> = edges.iter().map(|&e| mesh.edge_vertices(e)).collect();
-        let mut points: Vec<DVec3> = mesh.vertices().map(|v| mesh.position(v)).collect();
-        let slot: HashMap<VertexId, usize> =
-            mesh.vertices().enumerate().map(|(i, v)| (v, i)).collect();
-        points.extend(
-            ends.iter()
-                .map(|&[a, b]| 0.5 * (mesh.position(a) + mesh.position(b))),
-        );
-        let s = signed_distances(&points);
-        let at_midpoints = &s[slot.len()..];
+        let points: Vec<DVec3> = vertices
+            .iter()
+            .map(|&v| mesh.position(v))
+            .chain(
+                ends.iter()
+                    .map(|&[a, b]| 0.5 * (mesh.position(a) + mesh.position(b))),
+            )
+            .collect();
+        let s = first_order_distances(sdf, &points, epsilon);
+        let mut at_vertex = vec![0.0; mesh.vertex_capacity()];
+        for (v, &d) in vertices.iter().zip(&s) {
+            at_vertex[v.index()] = d;
+        }
         ends.iter()
-            .zip(at_midpoints)
+            .zip(&s[vertices.len()..])
             .map(|(&[a, b], &m)| {
-                let gap = (m - 0.5 * (s[slot[&a]] + s[slot[&b]])).abs();
+                let gap = (m - 0.5 * (at_vertex[a.index()] + at_vertex[b.index()])).abs();
                 if gap.is_finite() { gap } else { 0.0 }
             })
             .collect()
@@ -168,12 +163,9 @@ mod tests {
                 0.5 * (mesh.position(a) + mesh.position(b))
             })
             .collect();
-        let (values, gradients) = evaluate_with_gradients(field, &midpoints);
-        values
-            .iter()
-            .zip(&gradients)
-            .map(|(f, g)| f.abs() / g.length())
-            .fold(0.0, f64::max)
+        first_order_distances(field, &midpoints, 0.0)
+            .into_iter()
+            .fold(0.0_f64, |far, d| far.max(d.abs()))
     }
 
     #[test]
@@ -226,12 +218,9 @@ mod tests {
         let budget = 4 * mesh.n_faces();
         fill_to_budget_on_field(&mut mesh, budget, &field, 1e-10);
         let points: Vec<DVec3> = mesh.vertices().map(|v| mesh.position(v)).collect();
-        let (values, gradients) = evaluate_with_gradients(&field, &points);
-        let farthest = values
-            .iter()
-            .zip(&gradients)
-            .map(|(f, g)| f.abs() / g.length())
-            .fold(0.0, f64::max);
+        let farthest = first_order_distances(&field, &points, 0.0)
+            .into_iter()
+            .fold(0.0_f64, |far, d| far.max(d.abs()));
         assert!(farthest < 1e-6, "a vertex {farthest:.3e} off the zero set");
     }
 }

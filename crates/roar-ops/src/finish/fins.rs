@@ -32,7 +32,7 @@ use crate::blocks::guard::collapse_if_clean;
 use crate::finish::degenerate::reshaped_faces_ok;
 use crate::geometry::DEGENERATE_QUALITY;
 use glam::DVec3;
-use roar_mesh::spatial::Sdf;
+use roar_mesh::spatial::{Sdf, first_order_distances};
 use roar_mesh::{HalfedgeId, Mesh, VertexId};
 
 /// Options of [`collapse_fins`].
@@ -105,12 +105,12 @@ pub fn collapse_fins(mesh: &mut Mesh, sdf: &dyn Sdf, options: &FinOptions) -> Bl
 fn vertex_distances(mesh: &Mesh, sdf: &dyn Sdf, epsilon: f64) -> Vec<f64> {
     let vertices: Vec<VertexId> = mesh.vertices().collect();
     let points: Vec<DVec3> = vertices.iter().map(|&v| mesh.position(v)).collect();
-    let mut values = vec![0.0; points.len()];
-    let mut gradients = vec![DVec3::ZERO; points.len()];
-    sdf.values_and_gradients(&points, &mut values, &mut gradients);
     let mut distances = vec![0.0; mesh.vertex_capacity()];
-    for ((v, f), g) in vertices.iter().zip(&values).zip(&gradients) {
-        let d = (f / (g.length() + epsilon)).abs();
+    for (v, d) in vertices
+        .iter()
+        .zip(first_order_distances(sdf, &points, epsilon))
+    {
+        let d = d.abs();
         distances[v.index()] = if d.is_finite() { d } else { 0.0 };
     }
     distances

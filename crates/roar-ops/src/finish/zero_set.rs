@@ -3,7 +3,9 @@
 
 use glam::DVec3;
 use roar_mesh::Mesh;
-use roar_mesh::spatial::{Sdf, area_weighted_vertex_normals, triangle_normal, triangle_quality};
+use roar_mesh::spatial::{
+    Sdf, area_weighted_vertex_normals, first_order_distances, triangle_normal, triangle_quality,
+};
 
 use crate::geometry::{DEGENERATE_QUALITY, is_degenerate};
 use crate::untangle::{LimiterOptions, limit_steps};
@@ -143,14 +145,7 @@ fn mean_distances(mesh: &Mesh, positions: &[DVec3], sdf: &dyn Sdf, epsilon: f64)
             0.5 * (positions[a.index()] + positions[b.index()])
         })
         .collect();
-    let mut values = vec![0.0; midpoints.len()];
-    let mut gradients = vec![DVec3::ZERO; midpoints.len()];
-    sdf.values_and_gradients(&midpoints, &mut values, &mut gradients);
-    let distances: Vec<f64> = values
-        .iter()
-        .zip(&gradients)
-        .map(|(&f, g)| f / (g.length() + epsilon))
-        .collect();
+    let distances = first_order_distances(sdf, &midpoints, epsilon);
     let mut sums = vec![(0.0, 0.0); positions.len()];
     for f in mesh.faces() {
         let corners = mesh.face_vertices(f);
