@@ -290,7 +290,7 @@ pub struct OptimizeConfig {
     /// Stop the loop once its loss has levelled off: at a checkpoint, when no checkpoint of the
     /// last `level_window` iterations has a loss `level_tolerance` (relative) below the lowest
     /// one before them (0 = always run `iterations`; needs `checkpoint_interval > 0`).
-    /// Defaults 30 and 0.03 (50 and 0.01 in the scan schedule); off in the SDF schedule, whose
+    /// Defaults 20 and 0.03 (50 and 0.01 in the scan schedule); off in the SDF schedule, whose
     /// SDF loss starts at iteration 500.
     /// [INF] Not in the paper: the run finishes from the lowest-loss checkpoint, and on the wild
     /// meshes the loss levels off by iteration 50–100 (`docs/method.md`, "The loop stops when its
@@ -334,7 +334,7 @@ impl Default for OptimizeConfig {
             split_threshold: 0.02,
             smoothing_interval: 0,
             checkpoint_interval: 10,
-            level_window: 30,
+            level_window: 20,
             level_tolerance: 0.03,
             step_limiter: true,
             guard_intersections: false,
@@ -990,7 +990,7 @@ mod tests {
         assert_eq!(c.optimize.checkpoint_interval, 10);
         assert_eq!(
             (c.optimize.level_window, c.optimize.level_tolerance),
-            (30, 0.03)
+            (20, 0.03)
         );
         assert_eq!(ReconstructConfig::sdf_defaults().optimize.level_window, 0);
         let scans = ReconstructConfig::scan_defaults().optimize;
