@@ -150,6 +150,23 @@ fn silhouettes_and_orientations(
     (masks, orientations)
 }
 
+/// Per face, whether the walk of [`PairContext::pair`] started on it can meet a silhouette
+/// edge: whether a face with one lies fewer than [`MAX_WALK`] steps away across non-silhouette
+/// edges (the only ones the walk crosses). The other faces' pairs have no item, so the walk is
+/// skipped for them; with small triangles they are most of a view's differing pairs.
+fn silhouette_within_walk(masks: &[u8], neighbors: &EdgeNeighbors) -> Vec<bool> {
+    let mut reach: Vec<bool> = masks.iter().map(|&mask| mask != 0).collect();
+    for _ in 1..MAX_WALK {
+        let previous = reach.clone();
+        for (f, reached) in reach.iter_mut().enumerate() {
+            // A non-silhouette edge always has its one neighbour.
+            *reached |=
+                (0..3).any(|k| masks[f] & (1 << k) == 0 && previous[neighbors.face[f][k] as usize]);
+        }
+    }
+    reach
+}
+
 /// Finds the antialiasing items of one view. Items come in a deterministic order (horizontal
 /// pairs row by row, then vertical pairs), then are stably sorted by target pixel.
 pub fn antialias_items(
@@ -166,6 +183,7 @@ pub fn antialias_items(
         return Vec::new();
     }
     let (masks, orientations) = silhouettes_and_orientations(verts, triangles, neighbors);
+    let reach = silhouette_within_walk(&masks, neighbors);
     let mut items = Vec::new();
     let ctx = PairContext {
         verts,
@@ -175,14 +193,11 @@ pub fn antialias_items(
         depth,
         masks: &masks,
         orientations: &orientations,
+        reach: &reach,
     };
-    // Most differing pairs see two faces joined by a non-silhouette edge (the same smooth
-    // surface); `pair` would return nothing for them whichever face is in front, so they are
-    // skipped here without the depth comparison.
-    let smooth = |a: u32, b: u32| ctx.smooth_across(a, b) && ctx.smooth_across(b, a);
     for (y, row) in ids.chunks_exact(w).enumerate() {
         for_each_differing(row, &row[1..], |x| {
-            if !smooth(row[x], row[x + 1])
+            if ctx.may_have_item(row[x], row[x + 1])
                 && let Some(item) = ctx.pair(y * w + x, [x, y], true, w)
             {
                 items.push(item);
@@ -191,7 +206,7 @@ pub fn antialias_items(
     }
     let horizontal = items.len();
     for_each_differing(ids, &ids[w.min(ids.len())..], |p| {
-        if !smooth(ids[p], ids[p + w])
+        if ctx.may_have_item(ids[p], ids[p + w])
             && let Some(item) = ctx.pair(p, [p % w, p / w], false, w)
         {
             items.push(item);
@@ -273,6 +288,8 @@ struct PairContext<'a> {
     masks: &'a [u8],
     /// Per face, [`silhouettes_and_orientations`]' edge functions at the third corners.
     orientations: &'a [[f64; 3]],
+    /// Per face, [`silhouette_within_walk`].
+    reach: &'a [bool],
 }
 
 impl PairContext<'_> {
@@ -290,6 +307,16 @@ impl PairContext<'_> {
         let adjacent = self.neighbors.face[a as usize];
         let mask = self.masks[a as usize];
         (0..3).any(|k| adjacent[k] == b && mask & (1 << k) == 0)
+    }
+
+    /// Whether a pair of pixels that see faces `a` and `b` (different) can have an item,
+    /// whichever is in front: not when neither face can reach a silhouette edge, nor when they
+    /// are joined by a non-silhouette edge (the same smooth surface). Most differing pairs are
+    /// one or the other, and this settles them without the depth comparison and the walk.
+    fn may_have_item(&self, a: u32, b: u32) -> bool {
+        // The face in front is one of the two, never the background.
+        let reaches = |f: u32| f != BACKGROUND && self.reach[f as usize];
+        (reaches(a) || reaches(b)) && !(self.smooth_across(a, b) && self.smooth_across(b, a))
     }
 
     /// The item of pixel `p` at `p_xy` and its right (`horizontal`) or lower neighbour in an
@@ -315,6 +342,9 @@ impl PairContext<'_> {
             ((q, q_xy), (p, p_xy))
         };
         let face = self.ids[front];
+        if !self.reach[face as usize] {
+            return None;
+        }
         let mask = self.masks[face as usize];
         // Exit for the interior case: the other pixel sees the neighbour across a
         // non-silhouette edge, i.e. the same smooth surface.
@@ -428,6 +458,66 @@ mod tests {
                 );
             }
         }
+    }
+
+    #[test]
+    fn skipping_faces_out_of_walking_reach_keeps_every_item() {
+        use crate::camera::star_cameras;
+        use crate::raster::rasterize;
+        use roar_mesh::shapes::{icosphere, perturbed, torus};
+        // Bumpy closed surfaces with triangles of a few pixels (most differing pairs lie inside
+        // the surface, far from a silhouette) and self-occlusion, seen from several cameras:
+        // the items equal those of walking every pair that is not across a smooth edge.
+        let (mut items, mut skipped_faces) = (0, 0);
+        let shapes = [
+            perturbed(&icosphere(4), 0.02, 3),
+            perturbed(&torus(48, 24, 0.6, 0.25), 0.01, 4),
+        ];
+        for shape in &shapes {
+            let (positions, triangles) = shape.to_triangles();
+            let neighbors = EdgeNeighbors::new(&triangles);
+            for cam in star_cameras(3, 2, 160, 128) {
+                let verts: Vec<ProjectedVertex> =
+                    positions.iter().map(|&p| cam.project(p * 0.9)).collect();
+                let raster = rasterize(&verts, &triangles, 160, 128, false);
+                let (ids, depth) = (&raster.ids, &raster.depth);
+                let fast = antialias_items(&verts, &triangles, &neighbors, ids, depth, 160, 128);
+                let (masks, orientations) =
+                    silhouettes_and_orientations(&verts, &triangles, &neighbors);
+                let reach = vec![true; triangles.len()];
+                let every_face = PairContext {
+                    verts: &verts,
+                    triangles: &triangles,
+                    neighbors: &neighbors,
+                    ids,
+                    depth,
+                    masks: &masks,
+                    orientations: &orientations,
+                    reach: &reach,
+                };
+                let mut walked = Vec::new();
+                let w = 160;
+                for p in 0..ids.len() {
+                    if p % w + 1 < w && ids[p] != ids[p + 1] {
+                        walked.extend(every_face.pair(p, [p % w, p / w], true, w));
+                    }
+                }
+                let horizontal = walked.len();
+                for p in 0..ids.len() - w {
+                    if ids[p] != ids[p + w] {
+                        walked.extend(every_face.pair(p, [p % w, p / w], false, w));
+                    }
+                }
+                assert_eq!(fast, sorted_by_target(&walked, horizontal));
+                items += fast.len();
+                skipped_faces += silhouette_within_walk(&masks, &neighbors)
+                    .iter()
+                    .filter(|&&reached| !reached)
+                    .count();
+            }
+        }
+        assert!(items > 1000, "only {items} items");
+        assert!(skipped_faces > 1000, "only {skipped_faces} faces skipped");
     }
 
     #[test]
