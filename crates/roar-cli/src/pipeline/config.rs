@@ -279,13 +279,16 @@ pub struct OptimizeConfig {
     /// 3.05e-3 / 2.16e-3). The triangles are shaped after the final QEM instead
     /// (`final_smoothing_sweeps`).
     pub smoothing_interval: usize,
-    /// Every this many iterations, keep a copy of the loop's mesh and its loss (default 10; 0 =
-    /// only the last state). The run finishes from the kept state with the lowest loss (the last
-    /// one included) that the untangle block can clear (`run.optimize.finished_from_iteration`,
-    /// `run.optimize.untangle_failures` in the report). [INF] Not in the paper: the blocks make the loss
-    /// rise as well as fall, and after it levels off (by iteration 30–50 on the wild meshes at 1000
-    /// faces) it can drift up (libigl-camelhead: 0.0486 at iteration 50, 0.0535 at 199); and the
-    /// last state may be a tangle the untangle cannot clear.
+    /// Every this many iterations, keep a copy of the loop's mesh and its loss (default 5; 10
+    /// in the SDF and scan schedules; 0 = only the last state). The run finishes from the kept
+    /// state with the lowest loss (the last one included) that the untangle block can clear
+    /// (`run.optimize.finished_from_iteration`, `run.optimize.untangle_failures` in the
+    /// report). [INF] Not in the paper: the blocks make the loss rise as well as fall, and after
+    /// it levels off (by iteration 30–50 on the wild meshes at 1000 faces) it can drift up
+    /// (libigl-camelhead: 0.0486 at iteration 50, 0.0535 at 199); and the last state may be a
+    /// tangle the untangle cannot clear. The loop's stop (`level_window`) is tested at the
+    /// checkpoints, so 5 lets it stop up to 5 iterations sooner (`docs/method.md`); the SDF
+    /// schedule's 700 iterations keep every checkpoint in memory, and 10 halves that.
     pub checkpoint_interval: usize,
     /// Stop the loop once its loss has levelled off: at a checkpoint, when no checkpoint of the
     /// last `level_window` iterations has a loss `level_tolerance` (relative) below the lowest
@@ -333,7 +336,7 @@ impl Default for OptimizeConfig {
             split_interval: 10,
             split_threshold: 0.02,
             smoothing_interval: 0,
-            checkpoint_interval: 10,
+            checkpoint_interval: 5,
             level_window: 20,
             level_tolerance: 0.03,
             step_limiter: true,
@@ -443,6 +446,7 @@ impl ReconstructConfig {
             ..Self::default()
         };
         config.optimize.iterations = 700;
+        config.optimize.checkpoint_interval = 10;
         config.optimize.level_window = 0;
         config.keep_the_full_rig();
         config
@@ -452,14 +456,15 @@ impl ReconstructConfig {
     /// [`crate::pipeline::scans::SCAN_ENCLOSURE_WINDING_THRESHOLD`] closing every opening,
     /// however wide, since a scanned object is closed but the scanner never sees all of it (the
     /// bunny's base), every iteration on the full rig, and the loop's stop with the 50-iteration
-    /// window and 1 % tolerance `docs/scans.md` was measured with (the soups' 30 and 3 % are
-    /// measured on soups only).
+    /// window and 1 % tolerance and the checkpoints every 10 iterations `docs/scans.md` was
+    /// measured with (the soups' 20, 3 % and 5 are measured on soups only).
     pub fn scan_defaults() -> Self {
         let mut config = Self::default();
         config.init.enclosure_winding_threshold =
             crate::pipeline::scans::SCAN_ENCLOSURE_WINDING_THRESHOLD;
         config.init.enclosure_max_cap_fraction = 1.0;
         config.keep_the_full_rig();
+        config.optimize.checkpoint_interval = 10;
         config.optimize.level_window = 50;
         config.optimize.level_tolerance = 0.01;
         config
@@ -987,14 +992,22 @@ mod tests {
         assert_eq!(c.optimize.smoothing_interval, 0, "off by default");
         assert_eq!(c.finish.final_smoothing_sweeps, 3);
         assert_eq!(c.finish.data_flip_rounds, 5);
-        assert_eq!(c.optimize.checkpoint_interval, 10);
+        assert_eq!(c.optimize.checkpoint_interval, 5);
         assert_eq!(
             (c.optimize.level_window, c.optimize.level_tolerance),
             (20, 0.03)
         );
-        assert_eq!(ReconstructConfig::sdf_defaults().optimize.level_window, 0);
+        let sdf = ReconstructConfig::sdf_defaults().optimize;
+        assert_eq!((sdf.checkpoint_interval, sdf.level_window), (10, 0));
         let scans = ReconstructConfig::scan_defaults().optimize;
-        assert_eq!((scans.level_window, scans.level_tolerance), (50, 0.01));
+        assert_eq!(
+            (
+                scans.checkpoint_interval,
+                scans.level_window,
+                scans.level_tolerance
+            ),
+            (10, 50, 0.01)
+        );
         assert!(c.optimize.step_limiter);
         assert!(!c.optimize.guard_intersections, "off by default");
         assert_eq!(c.finish.final_qem_offset, 5e-4);
