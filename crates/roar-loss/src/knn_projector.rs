@@ -97,8 +97,16 @@ pub struct KnnPlanarProjector {
     points: Vec<DVec3>,
     /// Unit normals (zero where the input normal was zero: such points are never valid).
     normals: Vec<DVec3>,
+    /// `points` and `normals` again, laid out by the tree's slots ([`PointTree::slot_ids`];
+    /// zero in padding): a projection reads its neighbours' positions and normals from nearby
+    /// memory rather than from wherever the cloud's order put them.
+    by_slot: Vec<(DVec3, DVec3)>,
     options: KnnOptions,
 }
+
+/// A neighbour found by [`KnnPlanarProjector::nearest_into`]: (point index, exact squared
+/// distance, tree slot).
+type Found = (u32, f64, u32);
 
 impl KnnPlanarProjector {
     /// Builds the kd-tree over the target points `points` with normals `normals` (one per point,
@@ -109,10 +117,21 @@ impl KnnPlanarProjector {
         options: &KnnOptions,
     ) -> Result<Self, LossError> {
         check_cloud(points, normals)?;
+        let tree = PointTree::new(points);
+        let normals: Vec<DVec3> = normals.iter().map(|n| n.normalize_or_zero()).collect();
+        let by_slot = tree
+            .slot_ids()
+            .iter()
+            .map(|&i| match points.get(i as usize) {
+                Some(&p) => (p, normals[i as usize]),
+                None => (DVec3::ZERO, DVec3::ZERO),
+            })
+            .collect();
         Ok(Self {
-            tree: PointTree::new(points),
+            tree,
             points: points.to_vec(),
-            normals: normals.iter().map(|n| n.normalize_or_zero()).collect(),
+            normals,
+            by_slot,
             options: *options,
         })
     }
@@ -145,30 +164,24 @@ impl KnnPlanarProjector {
         let mut scratch = Neighbours::default();
         let mut found = Vec::new();
         self.nearest_into(p, k, &mut scratch, &mut found);
-        found
+        found.into_iter().map(|(j, d2, _)| (j, d2)).collect()
     }
 
     /// [`KnnPlanarProjector::nearest`] into reusable buffers (no allocation once warm).
-    fn nearest_into(
-        &self,
-        p: DVec3,
-        k: usize,
-        scratch: &mut Neighbours,
-        found: &mut Vec<(u32, f64)>,
-    ) {
+    fn nearest_into(&self, p: DVec3, k: usize, scratch: &mut Neighbours, found: &mut Vec<Found>) {
         found.clear();
         if !p.is_finite() {
             return;
         }
         self.tree.nearest_n(p, k, scratch);
         found.extend(
-            scratch
-                .items()
-                .map(|(_, j)| (j, self.points[j as usize].distance_squared(p))),
+            scratch.items().zip(scratch.slots()).map(|((_, j), &slot)| {
+                (j, self.by_slot[slot as usize].0.distance_squared(p), slot)
+            }),
         );
         // Squared distances of finite points are never negative nor NaN, so their bits order
         // like the numbers (as `total_cmp` would), and one integer key compares each pair.
-        found.sort_unstable_by_key(|&(j, d2)| (d2.to_bits(), j));
+        found.sort_unstable_by_key(|&(j, d2, _)| (d2.to_bits(), j));
     }
 
     /// The move `d` of sample `s` with unit normal `n` (spec §3.2.2 s2t steps 1–3): `None` when
@@ -185,7 +198,7 @@ impl KnnPlanarProjector {
         s: DVec3,
         n: DVec3,
         scratch: &mut Neighbours,
-        found: &mut Vec<(u32, f64)>,
+        found: &mut Vec<Found>,
     ) -> Option<DVec3> {
         if !s.is_finite() || !n.is_finite() {
             return None;
@@ -194,9 +207,10 @@ impl KnnPlanarProjector {
         planar_move(
             s,
             n,
-            found
-                .iter()
-                .map(|&(j, d2)| (self.points[j as usize], self.normals[j as usize], d2)),
+            found.iter().map(|&(_, d2, slot)| {
+                let (point, normal) = self.by_slot[slot as usize];
+                (point, normal, d2)
+            }),
             &self.options,
         )
     }

@@ -84,6 +84,8 @@ pub(crate) struct Neighbours {
 #[derive(Debug, Clone, Default)]
 struct Best {
     keys: Vec<u64>,
+    /// The tree slot of each key's point (see [`PointTree::slot_ids`]), in the keys' order.
+    slots: Vec<u32>,
     k: usize,
     /// A key enters iff it is below this: the limit's (any index) until `k` are found, then the
     /// current `k`-th key.
@@ -108,6 +110,11 @@ impl Neighbours {
             .iter()
             .map(|&key| (f32::from_bits((key >> 32) as u32), key as u32))
     }
+
+    /// The tree slot of each neighbour of [`Neighbours::items`], in the same order.
+    pub(crate) fn slots(&self) -> &[u32] {
+        &self.best.slots
+    }
 }
 
 impl Best {
@@ -115,29 +122,34 @@ impl Best {
     /// `limit` (not NaN).
     fn reset(&mut self, k: usize, limit: f32) {
         self.keys.clear();
+        self.slots.clear();
         self.k = k;
         self.enter_below = key(limit, u32::MAX).saturating_add(1);
         self.bound = limit;
     }
 
-    /// Inserts `(d2, id)` if it is among the `k` best so far (ties broken by smaller index).
+    /// Inserts `(d2, id)`, held by tree slot `slot`, if it is among the `k` best so far (ties
+    /// broken by smaller index).
     #[inline]
-    fn offer(&mut self, d2: f32, id: u32) {
+    fn offer(&mut self, d2: f32, id: u32, slot: u32) {
         let new = key(d2, id);
         if new >= self.enter_below {
             return;
         }
         if self.keys.len() < self.k {
             self.keys.push(new);
+            self.slots.push(slot);
         }
         // Shift the worse keys up by one (dropping the last when full) and insert.
-        let keys = &mut self.keys[..];
+        let (keys, slots) = (&mut self.keys[..], &mut self.slots[..]);
         let mut pos = keys.len() - 1;
         while pos > 0 && keys[pos - 1] > new {
             keys[pos] = keys[pos - 1];
+            slots[pos] = slots[pos - 1];
             pos -= 1;
         }
         keys[pos] = new;
+        slots[pos] = slot;
         if keys.len() == self.k {
             self.enter_below = keys[self.k - 1];
             self.bound = f32::from_bits((self.enter_below >> 32) as u32);
@@ -305,6 +317,13 @@ impl PointTree {
         &self.ids
     }
 
+    /// The input index held by each slot of the leaves (`u32::MAX` for padding), which
+    /// [`Neighbours::slots`] refer to: a caller that lays out its per-point data in this order
+    /// reads a query's neighbours from nearby memory.
+    pub(crate) fn slot_ids(&self) -> &[u32] {
+        &self.leaf_ids
+    }
+
     /// Fills `neighbours` with the `k` nearest points of `query` (fewer if the tree is
     /// smaller), sorted by (f32 squared distance, index). `k = 0` or an empty tree gives
     /// nothing. The buffer's previous answer (any `k` distinct points of this tree) bounds the
@@ -445,7 +464,7 @@ impl PointTree {
             }
             let d2 = self.leaf_distances(nd, q);
             let ids = &self.leaf_ids[nd.start as usize..nd.start as usize + LEAF_SIZE];
-            found.visit_leaf(&d2, ids);
+            found.visit_leaf(&d2, ids, nd.start);
             // Resume at the latest pending far child that is still within the bound.
             loop {
                 if len == 0 {
@@ -482,8 +501,8 @@ trait Collector {
     fn bound(&self) -> f32;
 
     /// Offers the points of one leaf: squared distances `d2` (NaN for padding) and input
-    /// indices `ids` of its slots.
-    fn visit_leaf(&mut self, d2: &[f32; LEAF_SIZE], ids: &[u32]);
+    /// indices `ids` of its slots, the first of which is `first_slot`.
+    fn visit_leaf(&mut self, d2: &[f32; LEAF_SIZE], ids: &[u32], first_slot: u32);
 }
 
 /// The single nearest point found so far, `(d2, id)` (ties: smaller index).
@@ -496,7 +515,7 @@ impl Collector for Nearest {
     }
 
     #[inline]
-    fn visit_leaf(&mut self, d2: &[f32; LEAF_SIZE], ids: &[u32]) {
+    fn visit_leaf(&mut self, d2: &[f32; LEAF_SIZE], ids: &[u32], _first_slot: u32) {
         let mut mask = within(d2, self.0);
         while mask != 0 {
             let i = mask.trailing_zeros() as usize;
@@ -518,12 +537,12 @@ impl Collector for Best {
     }
 
     #[inline]
-    fn visit_leaf(&mut self, d2: &[f32; LEAF_SIZE], ids: &[u32]) {
+    fn visit_leaf(&mut self, d2: &[f32; LEAF_SIZE], ids: &[u32], first_slot: u32) {
         let mut mask = within(d2, self.bound);
         while mask != 0 {
             let i = mask.trailing_zeros() as usize;
             mask &= mask - 1;
-            self.offer(d2[i], ids[i]);
+            self.offer(d2[i], ids[i], first_slot + i as u32);
         }
     }
 }
@@ -583,6 +602,11 @@ mod tests {
                         brute(&points, q, k),
                         "n {n} k {k}"
                     );
+                    // Each neighbour's slot holds that neighbour.
+                    assert_eq!(found.slots().len(), found.items().len());
+                    for ((_, id), &slot) in found.items().zip(found.slots()) {
+                        assert_eq!(tree.slot_ids()[slot as usize], id);
+                    }
                 }
                 for hint in [None, previous, Some(0)] {
                     assert_eq!(
