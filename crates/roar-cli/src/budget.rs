@@ -87,7 +87,10 @@ const FIXED_BYTES: u64 = 128 << 20;
 const BYTES_PER_WORKING_FACE: u64 = 2048;
 const BYTES_PER_INPUT_FACE: u64 = 512;
 const BYTES_PER_PIXEL: u64 = 40;
-const BYTES_PER_SAMPLE: u64 = 256;
+/// The cloud and its k-d tree, in each of the run's two k-NN projectors (the planar loss's and
+/// the blocks'), each also holding a copy of the points and normals in the tree's padded leaf
+/// slots (up to 2 × 48 bytes per point).
+const BYTES_PER_SAMPLE: u64 = 448;
 
 #[cfg(test)]
 mod tests {
