@@ -1,5 +1,5 @@
 //! One evaluation of the loop's objective (spec §3.2.3: `3·L_render + 1·L_planar`, built by
-//! `roar_cli::pipeline::default_loss`) on a real mesh, and its parts on their own. A soup's loop
+//! `roar::default_loss`) on a real mesh, and its parts on their own. A soup's loop
 //! and polish render the default rig coarse (25 views × 256², `render_coarse_resolution`), the
 //! paper the full rig (36 × 512², the SDF and scan schedules): `loop_*` and `render_coarse_*`
 //! are the former, `full_*`, `render_forward_*` and `render_forward_backward_*` the latter;
@@ -13,7 +13,7 @@ mod homer;
 
 use criterion::{Criterion, criterion_group};
 use homer::Homer;
-use roar_cli::pipeline::{default_loss, planar_options};
+use roar::{default_loss, planar_options};
 use roar_loss::{Loss, PlanarLoss, RenderLoss};
 use roar_render::{RenderOptions, render};
 

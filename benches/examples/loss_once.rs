@@ -14,7 +14,7 @@
 mod homer;
 
 use homer::Homer;
-use roar_cli::pipeline::{default_loss, planar_options};
+use roar::{default_loss, planar_options};
 use roar_loss::{Loss, PlanarLoss, RenderLoss};
 
 fn main() {

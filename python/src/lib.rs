@@ -16,7 +16,7 @@ use pyo3::create_exception;
 use pyo3::exceptions::{PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyBytes, PyDict};
-use roar_cli::pipeline::{PipelineError, Progress, ReconstructConfig, Reconstruction, SoupShape};
+use roar::{PipelineError, Progress, ReconstructConfig, Reconstruction, SoupShape};
 use roar_eval::EvalOptions;
 use roar_io::TriangleSoup;
 use roar_mesh::Mesh;
@@ -228,7 +228,7 @@ fn eval(
 
 /// The soup welded at bit-identical positions as a closed 2-manifold, or the CLI's message.
 fn closed_mesh(soup: &TriangleSoup) -> PyResult<Mesh> {
-    let (positions, triangles) = roar_cli::input::welded_referenced(soup);
+    let (positions, triangles) = roar::input::welded_referenced(soup);
     Mesh::from_triangles(positions, &triangles).map_err(|e| {
         PyValueError::new_err(format!(
             "the mesh is not a closed, oriented 2-manifold (run roar.init on it first): {e}"
@@ -271,8 +271,8 @@ fn init<'py>(
     faces: usize,
 ) -> PyResult<(Bound<'py, PyBytes>, Bound<'py, PyBytes>)> {
     let soup = soup_from_bytes(positions, triangles)?;
-    roar_cli::input::check_even_budget(faces).map_err(|e| PyValueError::new_err(e.to_string()))?;
-    let (positions, triangles) = roar_cli::input::welded_referenced(&soup);
+    roar::budget::check_even_budget(faces).map_err(|e| PyValueError::new_err(e.to_string()))?;
+    let (positions, triangles) = roar::input::welded_referenced(&soup);
     let options = roar_ops::init::InitialMeshOptions {
         init: roar_ops::init::InitOptions {
             resolution: if resolution == 0 {

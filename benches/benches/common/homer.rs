@@ -8,7 +8,7 @@
 use std::path::PathBuf;
 
 use glam::DVec3;
-use roar_cli::pipeline::{Prepared, ReconstructConfig, coarse_rig_cameras, target_options};
+use roar::{Prepared, ReconstructConfig, coarse_rig_cameras, target_options};
 use roar_loss::{PointCloud, PointCloudOptions, Target, build_target, point_cloud, render_views};
 use roar_mesh::Mesh;
 use roar_ops::decimate::{DecimateOptions, decimate};

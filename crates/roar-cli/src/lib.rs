@@ -1,14 +1,10 @@
 //! # roar-cli
 //!
 //! The library half of the `roar` command: one module per subcommand (argument struct plus a
-//! `run` function), and the reconstruction pipeline that composes the other crates
-//! ([`pipeline::Reconstruction`], with replaceable losses and blocks).
+//! `run` function) over the [`roar`] pipeline crate, the batch runner and the preview picture.
 
 pub mod batch;
-pub mod budget;
 pub mod checks;
 pub mod commands;
-pub mod example;
-pub mod input;
-pub mod pipeline;
+pub mod mesh_files;
 pub mod preview;

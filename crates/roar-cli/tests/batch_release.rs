@@ -57,7 +57,7 @@ fn id(position: usize) -> String {
 fn forty_items_in_four_shards_survive_a_killed_shard() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
-    let soup = roar_cli::example::chair_soup();
+    let soup = roar::example::chair_soup();
     for ext in ["obj", "ply", "off", "stl"] {
         roar_io::write_mesh(&d.join(format!("chair.{ext}")), &soup).unwrap();
     }

@@ -5,12 +5,12 @@ mod common;
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 
-use roar_cli::pipeline::{PipelineError, Reconstruction};
+use roar::{PipelineError, Reconstruction};
 
 #[test]
 fn a_set_cancel_flag_stops_the_run_at_the_next_report() {
     let config = common::toy_config(200, 50);
-    let soup = roar_cli::example::chair_soup();
+    let soup = roar::example::chair_soup();
     let flag = Arc::new(AtomicBool::new(false));
     let mut reconstruction = Reconstruction::new(config);
     reconstruction.cancel = Some(flag.clone());

@@ -5,7 +5,7 @@
 mod common;
 
 use glam::DVec3;
-use roar_cli::pipeline::Reconstruction;
+use roar::Reconstruction;
 use roar_io::TriangleSoup;
 
 /// A `.glb` holding one mesh (f32 positions, u32 indices) instanced twice: node 0 translated by
@@ -39,7 +39,7 @@ fn reconstruct_to_obj(path: &std::path::Path, out: &std::path::Path) -> Vec<u8> 
 
 #[test]
 fn a_gltf_scene_reconstructs_like_its_soup_as_obj() {
-    let chair = roar_cli::example::chair_soup();
+    let chair = roar::example::chair_soup();
     let points: Vec<[f32; 3]> = chair
         .positions
         .iter()

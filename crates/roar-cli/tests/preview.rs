@@ -3,7 +3,7 @@
 
 mod common;
 
-use roar_cli::pipeline::Reconstruction;
+use roar::Reconstruction;
 use std::path::{Path, PathBuf};
 
 use roar_cli::commands::reconstruct::ReconstructArgs;
@@ -30,7 +30,7 @@ fn count(image: &PreviewImage, region: (u32, u32, u32, u32)) -> (usize, usize) {
 
 #[test]
 fn the_preview_shows_input_output_wireframe_and_curve() {
-    let soup = roar_cli::example::chair_soup();
+    let soup = roar::example::chair_soup();
     let out = Reconstruction::new(common::toy_config(200, 6))
         .run_soup(&soup.positions, &soup.triangles, &mut |_| {})
         .unwrap();
@@ -82,7 +82,7 @@ fn the_preview_shows_input_output_wireframe_and_curve() {
 fn the_flag_refuses_a_non_png_name_before_any_work() {
     let dir = tempfile::tempdir().unwrap();
     let input = dir.path().join("chair.obj");
-    roar_io::write_mesh(&input, &roar_cli::example::chair_soup()).unwrap();
+    roar_io::write_mesh(&input, &roar::example::chair_soup()).unwrap();
     let args = roar_cli::commands::reconstruct::ReconstructArgs {
         input: Some(input),
         output: Some(dir.path().join("out.obj")),

@@ -14,7 +14,7 @@
 
 use std::path::PathBuf;
 
-use roar_cli::pipeline::{ReconstructConfig, Reconstruction};
+use roar::{ReconstructConfig, Reconstruction};
 use roar_eval::{ChamferOptions, fidelity};
 use roar_mesh::Mesh;
 use roar_mesh::spatial::self_intersecting_faces;
@@ -70,8 +70,8 @@ fn chamfer_over_diag(
 
 /// What one input gave: roar's output and the init + QEM baseline, both at `FACES`.
 struct Run {
-    out: roar_cli::pipeline::Output,
-    baseline: roar_cli::pipeline::Output,
+    out: roar::Output,
+    baseline: roar::Output,
     seconds: f64,
 }
 

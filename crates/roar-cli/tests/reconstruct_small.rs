@@ -1,9 +1,7 @@
 //! The pipeline at toy settings (few views, low resolution, few iterations), fast enough for the
 //! default test run: its promises hold and it is deterministic.
 
-use roar_cli::pipeline::{
-    InitKind, PipelineError, ReconstructConfig, Reconstruction, RunStats, ScheduledBlock,
-};
+use roar::{InitKind, PipelineError, ReconstructConfig, Reconstruction, RunStats, ScheduledBlock};
 use roar_mesh::shapes::torus;
 use roar_mesh::spatial::self_intersecting_faces;
 use roar_mesh::{Mesh, TrackedMesh};
@@ -25,7 +23,7 @@ fn run_with(
     config: ReconstructConfig,
     extra: Vec<ScheduledBlock>,
 ) -> (Vec<glam::DVec3>, Vec<[u32; 3]>, RunStats) {
-    let soup = roar_cli::example::chair_soup();
+    let soup = roar::example::chair_soup();
     let config_iterations = config.optimize.iterations;
     let (polish_iterations, faces) = (config.finish.polish_iterations, config.faces);
     let mut stages = Vec::new();

@@ -7,7 +7,7 @@ mod common;
 
 use std::path::PathBuf;
 
-use roar_cli::pipeline::{ReconstructConfig, Reconstruction, SoupShape, load_scans};
+use roar::{ReconstructConfig, Reconstruction, SoupShape, load_scans};
 use roar_eval::{ChamferOptions, fidelity};
 use roar_mesh::Mesh;
 use roar_mesh::spatial::self_intersecting_faces;

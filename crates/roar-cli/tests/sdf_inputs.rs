@@ -11,8 +11,8 @@ use std::process::{Command, Output};
 use std::sync::Arc;
 
 use glam::DVec3;
-use roar_cli::pipeline::sdf::DEFAULT_BOUNDS;
-use roar_cli::pipeline::{ReconstructConfig, Reconstruction, SdfShape};
+use roar::shapes::sdf::DEFAULT_BOUNDS;
+use roar::{ReconstructConfig, Reconstruction, SdfShape};
 use roar_mesh::Mesh;
 use roar_mesh::spatial::{
     Aabb, Sdf, TriangleBvh, evaluate_with_gradients, self_intersecting_faces,

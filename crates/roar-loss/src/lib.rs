@@ -3,9 +3,7 @@
 //! The reconstruction target (the cleaned soup T′, its renders, the oriented point cloud P) and
 //! the losses that drive the vertices: the render loss and the planar projection loss (spec
 //! §3.1–§3.4), behind the common [`Loss`] trait so a researcher can add or swap a term without
-//! touching the pipeline. [`Shape`] is the seam between an input of any kind and the pipeline:
-//! what it must offer (bounds, renders, a point cloud, an initial mesh, optionally a signed
-//! distance).
+//! touching the pipeline.
 
 pub mod knn_projector;
 pub mod planar;
@@ -20,7 +18,6 @@ use rayon::prelude::*;
 pub mod point_cloud;
 pub mod render_loss;
 pub mod sdf_loss;
-pub mod shape;
 pub mod sharp_edges;
 pub mod target;
 
@@ -30,7 +27,6 @@ pub use point_cloud::{
 pub use render_loss::{CoarseViews, RenderLoss};
 pub use roar_mesh::spatial::{Sdf, SdfEvaluations};
 pub use sdf_loss::{SdfLoss, SdfLossOptions};
-pub use shape::{InitialMesh, Shape, ShapeError, ShapeSummary};
 pub use sharp_edges::{SharpEdge, SharpEdgeOptions, sharp_edge_samples, sharp_edges};
 pub use target::{Target, TargetOptions, TargetStats, build_target, render_views};
 

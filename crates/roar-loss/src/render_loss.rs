@@ -53,7 +53,7 @@ impl RenderLoss {
     }
 
     /// The paper's render loss against `renders`, one per camera of `cameras` (as a
-    /// [`crate::Shape`] gives them): source culling off, antialiasing on, L1. Clones both.
+    /// the pipeline's `Shape` gives them): source culling off, antialiasing on, L1. Clones both.
     pub fn from_renders(cameras: &[Camera], renders: &[Image]) -> Self {
         Self {
             cameras: cameras.to_vec(),

@@ -501,8 +501,8 @@ impl Progress {
 mod tests {
     use super::{BatchArgs, effective_config, parse_memory, reconstruct_args};
     use crate::batch::manifest::Item;
-    use crate::pipeline::ReconstructConfig;
     use clap::Parser;
+    use roar::ReconstructConfig;
 
     #[derive(Parser)]
     struct Cli {

@@ -10,9 +10,9 @@ use clap::Args;
 use roar_ops::decimate::{DecimateOptions, decimate_in_parallel};
 use roar_ops::finish::genus::{HandleRemovalOptions, decimate_removing_handles};
 
-use crate::budget::{check_budget, min_reachable_budget, parse_faces};
 use crate::checks::check_paths;
-use crate::input::{read_closed_mesh, write_mesh};
+use crate::mesh_files::{parse_faces, read_closed_mesh, write_mesh};
+use roar::budget::{check_budget, smallest_budget};
 
 /// Arguments of `roar decimate`.
 #[derive(Args, Debug)]
@@ -44,8 +44,8 @@ pub struct DecimateArgs {
 pub fn run(args: &DecimateArgs) -> anyhow::Result<()> {
     check_paths(&[("INPUT", &args.input)], &[("-o", &args.output)])?;
     let mut mesh = read_closed_mesh(&args.input)?;
-    let minimum = min_reachable_budget(&mesh.component_genera(), !args.reduce_genus);
-    check_budget("--faces", args.faces, minimum).map_err(anyhow::Error::msg)?;
+    let minimum = smallest_budget(&mesh.component_genera(), !args.reduce_genus);
+    check_budget("--faces", args.faces, minimum)?;
     if args.faces > mesh.n_faces() {
         anyhow::bail!(
             "--faces {} is above the {} faces of {}: decimation only removes faces \

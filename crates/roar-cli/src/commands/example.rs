@@ -14,7 +14,7 @@ pub struct ExampleArgs {
 /// Runs `roar example-soup`.
 pub fn run(args: &ExampleArgs) -> anyhow::Result<()> {
     crate::checks::check_paths(&[], &[("OUTPUT", &args.output)])?;
-    let soup = crate::example::chair_soup();
+    let soup = roar::example::chair_soup();
     roar_io::write_mesh(&args.output, &soup)?;
     eprintln!(
         "wrote {} ({} vertices, {} triangles)",

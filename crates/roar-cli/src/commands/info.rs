@@ -63,7 +63,7 @@ pub fn info(path: &std::path::Path) -> anyhow::Result<Info> {
     let soup = roar_io::read_mesh(path)?;
     let (welded, _) = soup.welded();
     let (positions, triangles) =
-        crate::input::drop_unreferenced(&welded.positions, &welded.triangles);
+        roar::input::drop_unreferenced(&welded.positions, &welded.triangles);
     let bbox = bounding_box(&positions)
         .with_context(|| format!("{}: no referenced vertices", path.display()))?;
     let mut info = Info {

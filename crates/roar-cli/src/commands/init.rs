@@ -8,7 +8,9 @@ use anyhow::Context;
 use clap::Args;
 use roar_ops::init::{InitOptions, InitialMeshOptions, initial_mesh};
 
-use crate::input::{check_even_budget, welded_referenced, write_mesh};
+use crate::mesh_files::write_mesh;
+use roar::budget::check_even_budget;
+use roar::input::welded_referenced;
 
 /// Arguments of `roar init`.
 #[derive(Args, Debug)]

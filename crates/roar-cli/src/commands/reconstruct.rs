@@ -15,11 +15,11 @@ use serde::Serialize;
 use crate::checks::check_paths;
 use crate::preview::{PreviewInput, PreviewOptions, preview_cameras};
 use glam::DVec3;
-use roar_loss::Shape;
+use roar::Shape;
 use roar_mesh::spatial::{Aabb, evaluate_with_gradients};
 
-use crate::pipeline::sdf::{DEFAULT_BOUNDS, SdfReport};
-use crate::pipeline::{
+use roar::shapes::sdf::{DEFAULT_BOUNDS, SdfReport};
+use roar::{
     InitKind, Progress as PipelineProgress, ReconstructConfig, Reconstruction, RunStats,
     ScanReport, SdfShape, SoupShape, load_scans,
 };
@@ -37,7 +37,7 @@ pub struct ReconstructArgs {
     #[arg(short, long)]
     pub output: Option<PathBuf>,
     /// Exact face count of the result (even, at least 4 per piece).
-    #[arg(long, allow_negative_numbers = true, value_parser = crate::budget::parse_faces)]
+    #[arg(long, allow_negative_numbers = true, value_parser = crate::mesh_files::parse_faces)]
     pub faces: Option<usize>,
     /// TOML file overriding any configuration key (see `--print-config`).
     #[arg(long)]
@@ -516,21 +516,21 @@ impl ProgressLines {
 }
 
 /// Refuses, before the run, a budget whose estimated peak memory
-/// ([`crate::budget::estimated_peak_bytes`]) exceeds the memory this machine has available
+/// ([`roar::budget::estimated_peak_bytes`]) exceeds the memory this machine has available
 /// (`MemAvailable` of `/proc/meminfo`), unless `force`.
 fn check_resources(
     config: &ReconstructConfig,
     input_faces: usize,
     force: bool,
 ) -> anyhow::Result<()> {
-    let needed = crate::budget::estimated_peak_bytes(&crate::budget::RunSizes {
+    let needed = roar::budget::estimated_peak_bytes(&roar::budget::RunSizes {
         working_faces: config.working_budget(),
         input_faces,
         render_pixels: (config.target.views_per_axis * config.target.views_per_axis) as u64
             * u64::from(config.target.render_resolution).pow(2),
         cloud_samples: config.target.point_cloud_samples,
     });
-    let Some(available) = crate::budget::available_memory_bytes() else {
+    let Some(available) = roar::budget::available_memory_bytes() else {
         return Ok(());
     };
     if needed > available && !force {

@@ -7,7 +7,7 @@ use std::path::PathBuf;
 use clap::Args;
 
 use crate::checks::check_paths;
-use crate::pipeline::{ReconstructConfig, load_scans};
+use roar::{ReconstructConfig, load_scans};
 
 /// Arguments of `roar scans`.
 #[derive(Args, Debug)]

@@ -5,7 +5,7 @@
 #[path = "../../../roar-io/tests/common/gltf.rs"]
 pub mod gltf;
 
-use roar_cli::pipeline::{InitConfig, LossConfig, OptimizeConfig, ReconstructConfig, TargetConfig};
+use roar::{InitConfig, LossConfig, OptimizeConfig, ReconstructConfig, TargetConfig};
 
 /// Few views, low resolutions (the loop's views at 32², the polish's at 64²), few iterations
 /// (as `reconstruct_small` uses), at `faces`.

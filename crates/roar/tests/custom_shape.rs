@@ -8,13 +8,11 @@ use std::rc::Rc;
 use std::sync::Arc;
 
 use glam::DVec3;
-use roar_cli::pipeline::{
-    FinishConfig, LossConfig, OptimizeConfig, Prepared, ReconstructConfig, Reconstruction,
-    TargetConfig, default_loss,
+use roar::{
+    FinishConfig, InitialMesh, LossConfig, OptimizeConfig, Prepared, ReconstructConfig,
+    Reconstruction, Shape, ShapeError, ShapeSummary, TargetConfig, default_loss,
 };
-use roar_loss::{
-    InitialMesh, PointCloud, Sdf, SdfEvaluations, Shape, ShapeError, ShapeSummary, render_views,
-};
+use roar_loss::{PointCloud, Sdf, SdfEvaluations, render_views};
 use roar_mesh::Mesh;
 use roar_mesh::shapes::icosphere;
 use roar_mesh::spatial::{

@@ -23,13 +23,16 @@ use roar_ops::finish::slivers::{SliverOptions, flip_slivers};
 use roar_ops::finish::zero_set::{ZeroSetOptions, ZeroSetStats, fit_to_zero_set};
 use roar_ops::untangle::{UntangleOptions, UntangleStats, untangle};
 
-use super::optimize::{LoopState, move_vertices, new_optimizer};
-use super::{PipelineError, ReconstructConfig, Run, RunStats, StageClock, UntangleFailure};
+use crate::config::ReconstructConfig;
+use crate::error::PipelineError;
+use crate::report::{RunStats, UntangleFailure};
+use crate::run::{Run, StageClock};
+use crate::stages::optimize::{LoopState, move_vertices, new_optimizer};
 
 /// Finishes from the loop's `states` with `loss` (dropped before the sliver flips), the
 /// cloud's `projector` (for the data flips) and the shape's `field`, if it has one; returns the
 /// final mesh in rig coordinates.
-pub(super) fn finish(
+pub(crate) fn finish(
     states: Vec<LoopState>,
     mut loss: Box<dyn Loss>,
     projector: &KnnPlanarProjector,

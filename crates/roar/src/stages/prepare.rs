@@ -1,14 +1,16 @@
 //! The prepare stage: the shape's own set-up (for a soup: weld, normalize, twin clean-up and
 //! the target renders) for the camera rig, and the normalization the output is undone with.
 
-use roar_loss::Shape;
 use roar_mesh::spatial::Normalization;
 use roar_render::Camera;
 
-use super::{PipelineError, Run, rig_cameras};
+use crate::error::PipelineError;
+use crate::rig::rig_cameras;
+use crate::run::Run;
+use crate::shape::Shape;
 
 /// What the prepare stage hands on: the rig and the input's normalization.
-pub(super) struct Target {
+pub(crate) struct Target {
     /// The camera rig ([`rig_cameras`]), for which the shape renders its target.
     pub cameras: Vec<Camera>,
     /// Input → rig coordinates; inverted on the output.
@@ -16,7 +18,7 @@ pub(super) struct Target {
 }
 
 /// Prepares `shape` for the rig of `run.config` and records the target's figures.
-pub(super) fn prepare(shape: &mut dyn Shape, run: &mut Run) -> Result<Target, PipelineError> {
+pub(crate) fn prepare(shape: &mut dyn Shape, run: &mut Run) -> Result<Target, PipelineError> {
     run.report("target", 0, f64::NAN, 0)?;
     let cameras = rig_cameras(run.config);
     shape.prepare(&cameras)?;

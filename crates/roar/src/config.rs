@@ -4,6 +4,14 @@
 
 use serde::{Deserialize, Serialize};
 
+/// The enclosure rule's threshold for scan sets (`enclosure_winding_threshold` of
+/// `ReconstructConfig::scan_defaults`), below the
+/// soups' `roar_ops::init::ENCLOSURE_WINDING_THRESHOLD` (0.7) because scans leave wider
+/// openings: four bunny scans around its side (bun000, bun090, bun180, bun270; top and base
+/// unscanned) give an init of genus 1 at 0.7 (a tunnel from top to base) and of genus 0 at 0.6
+/// and 0.5.
+pub const SCAN_ENCLOSURE_WINDING_THRESHOLD: f64 = 0.6;
+
 /// How the initial mesh M0 is made (spec §4).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
@@ -453,15 +461,14 @@ impl ReconstructConfig {
     }
 
     /// The defaults for a set of range scans: the soup's, with the init's enclosure rule at
-    /// [`crate::pipeline::scans::SCAN_ENCLOSURE_WINDING_THRESHOLD`] closing every opening,
+    /// [`SCAN_ENCLOSURE_WINDING_THRESHOLD`] closing every opening,
     /// however wide, since a scanned object is closed but the scanner never sees all of it (the
     /// bunny's base), every iteration on the full rig, and the loop's stop with the 50-iteration
     /// window and 1 % tolerance and the checkpoints every 10 iterations `docs/scans.md` was
     /// measured with (the soups' 20, 3 % and 5 are measured on soups only).
     pub fn scan_defaults() -> Self {
         let mut config = Self::default();
-        config.init.enclosure_winding_threshold =
-            crate::pipeline::scans::SCAN_ENCLOSURE_WINDING_THRESHOLD;
+        config.init.enclosure_winding_threshold = SCAN_ENCLOSURE_WINDING_THRESHOLD;
         config.init.enclosure_max_cap_fraction = 1.0;
         config.keep_the_full_rig();
         config.optimize.checkpoint_interval = 10;
@@ -494,7 +501,7 @@ impl ReconstructConfig {
     /// the rules between fields, before any work; the one-line error names the field, its value
     /// and what is allowed. NaN and infinities are outside every range.
     pub fn validate(&self) -> Result<(), String> {
-        crate::budget::check_budget("faces =", self.faces, 4)?;
+        crate::budget::check_budget("faces =", self.faces, 4).map_err(|e| e.to_string())?;
         for (range, value) in self.field_ranges() {
             if !range.allows(value) {
                 return Err(format!(

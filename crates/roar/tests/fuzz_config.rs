@@ -10,7 +10,7 @@ use std::panic::{AssertUnwindSafe, catch_unwind};
 
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-use roar_cli::pipeline::ReconstructConfig;
+use roar::ReconstructConfig;
 
 #[test]
 fn the_config_parser_survives_mutated_seeds() {

@@ -25,13 +25,16 @@ use std::path::Path;
 use std::time::Instant;
 
 use glam::DVec3;
-use roar_cli::pipeline::{
+use roar::{
     OptimizeConfig, PipelineError, Prepared, ReconstructConfig, Reconstruction, default_loss,
     planar_options, target_options,
 };
 use roar_loss::{Loss, LossError, PlanarLoss, PointCloud, RenderLoss, build_target};
 
-fn main() -> anyhow::Result<()> {
+/// Any error, as one line for the terminal.
+type Result<T, E = Box<dyn std::error::Error>> = std::result::Result<T, E>;
+
+fn main() -> Result<()> {
     let args: Vec<String> = std::env::args().collect();
     if std::env::var_os("SINGLE").is_some() {
         rayon::ThreadPoolBuilder::new()
@@ -41,7 +44,7 @@ fn main() -> anyhow::Result<()> {
     }
     let usage = "usage: loss_profile dump MESH STATE [FACES] [AT] | eval MESH STATE [EVALS] [TERM]";
     let (Some(mode), Some(mesh), Some(state)) = (args.get(1), args.get(2), args.get(3)) else {
-        anyhow::bail!(usage);
+        return Err(usage.into());
     };
     match mode.as_str() {
         "dump" => {
@@ -54,7 +57,7 @@ fn main() -> anyhow::Result<()> {
             let term = args.get(5).map_or("all", |a| a.as_str());
             eval(Path::new(mesh), Path::new(state), evals, term)
         }
-        _ => anyhow::bail!(usage),
+        _ => Err(usage.into()),
     }
 }
 
@@ -88,7 +91,7 @@ impl Loss for Dumper {
     }
 }
 
-fn dump(mesh: &Path, state: &Path, faces: usize, at: usize) -> anyhow::Result<()> {
+fn dump(mesh: &Path, state: &Path, faces: usize, at: usize) -> Result<()> {
     let soup = roar_io::read_mesh(mesh)?;
     let config = ReconstructConfig {
         faces,
@@ -118,7 +121,7 @@ fn dump(mesh: &Path, state: &Path, faces: usize, at: usize) -> anyhow::Result<()
             Ok(())
         }
         Err(e) => Err(e.into()),
-        Ok(_) => anyhow::bail!("the run ended before evaluation {at}"),
+        Ok(_) => Err(format!("the run ended before evaluation {at}").into()),
     }
 }
 
@@ -160,19 +163,19 @@ struct Cursor<'a> {
 }
 
 impl Cursor<'_> {
-    fn take<const N: usize>(&mut self) -> anyhow::Result<[u8; N]> {
+    fn take<const N: usize>(&mut self) -> Result<[u8; N]> {
         let Some((head, rest)) = self.bytes.split_first_chunk::<N>() else {
-            anyhow::bail!("truncated state file");
+            return Err("truncated state file".into());
         };
         self.bytes = rest;
         Ok(*head)
     }
 
-    fn len(&mut self) -> anyhow::Result<usize> {
+    fn len(&mut self) -> Result<usize> {
         Ok(u64::from_le_bytes(self.take()?) as usize)
     }
 
-    fn vec3(&mut self) -> anyhow::Result<DVec3> {
+    fn vec3(&mut self) -> Result<DVec3> {
         let mut v = [0.0; 3];
         for x in &mut v {
             *x = f64::from_le_bytes(self.take()?);
@@ -181,7 +184,7 @@ impl Cursor<'_> {
     }
 }
 
-fn read_state(path: &Path) -> anyhow::Result<State> {
+fn read_state(path: &Path) -> Result<State> {
     let mut bytes = Vec::new();
     std::fs::File::open(path)?.read_to_end(&mut bytes)?;
     let mut cursor = Cursor { bytes: &bytes };
@@ -192,9 +195,7 @@ fn read_state(path: &Path) -> anyhow::Result<State> {
         normals.push(cursor.vec3()?);
     }
     let nv = cursor.len()?;
-    let positions = (0..nv)
-        .map(|_| cursor.vec3())
-        .collect::<anyhow::Result<Vec<_>>>()?;
+    let positions = (0..nv).map(|_| cursor.vec3()).collect::<Result<Vec<_>>>()?;
     let nt = cursor.len()?;
     let mut triangles = Vec::with_capacity(nt);
     for _ in 0..nt {
@@ -220,7 +221,7 @@ fn fold_bits(hash: u64, value: f64, grad: &[DVec3]) -> u64 {
     h
 }
 
-fn eval(mesh: &Path, state: &Path, evals: usize, term: &str) -> anyhow::Result<()> {
+fn eval(mesh: &Path, state: &Path, evals: usize, term: &str) -> Result<()> {
     let config = ReconstructConfig::default();
     let soup = roar_io::read_mesh(mesh)?;
     let (points, normals, positions, triangles) = read_state(state)?;
@@ -231,7 +232,7 @@ fn eval(mesh: &Path, state: &Path, evals: usize, term: &str) -> anyhow::Result<(
         positions.len(),
         triangles.len()
     );
-    let planar = || -> anyhow::Result<Box<dyn Loss>> {
+    let planar = || -> Result<Box<dyn Loss>> {
         Ok(Box::new(PlanarLoss::new(
             &cloud.points,
             &cloud.normals,
@@ -257,7 +258,7 @@ fn eval(mesh: &Path, state: &Path, evals: usize, term: &str) -> anyhow::Result<(
                 })?
             }
         }
-        _ => anyhow::bail!("TERM is all, render or planar"),
+        _ => return Err("TERM is all, render or planar".into()),
     };
     let mut hash = 0xcbf2_9ce4_8422_2325;
     for i in 0..evals {

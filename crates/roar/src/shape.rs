@@ -24,7 +24,7 @@ use roar_mesh::Mesh;
 use roar_mesh::spatial::{Normalization, Projector, Sdf};
 use roar_render::{Camera, Image};
 
-use crate::{LossError, PointCloud};
+use roar_loss::{LossError, PointCloud};
 
 /// Why a shape could not give what the pipeline asked for.
 #[derive(Debug, thiserror::Error)]

@@ -18,7 +18,7 @@ use roar_ops::align::{AlignOptions, RigidTransform, ScanPatch, align_scans};
 use roar_ops::init::ScannerView;
 use serde::Serialize;
 
-use super::ReconstructConfig;
+use crate::config::ReconstructConfig;
 
 /// What happened to one scan, for reports.
 #[derive(Debug, Clone, Serialize)]
@@ -159,11 +159,3 @@ pub fn load_scans(
         toward_scanner,
     })
 }
-
-/// The enclosure rule's threshold for scan sets (`enclosure_winding_threshold` of
-/// `ReconstructConfig::scan_defaults`), below the
-/// soups' `roar_ops::init::ENCLOSURE_WINDING_THRESHOLD` (0.7) because scans leave wider
-/// openings: four bunny scans around its side (bun000, bun090, bun180, bun270; top and base
-/// unscanned) give an init of genus 1 at 0.7 (a tunnel from top to base) and of genus 0 at 0.6
-/// and 0.5.
-pub const SCAN_ENCLOSURE_WINDING_THRESHOLD: f64 = 0.6;

@@ -8,8 +8,8 @@
 use std::path::PathBuf;
 
 use glam::DVec3;
-use roar_cli::example::chair_soup;
-use roar_cli::pipeline::{
+use roar::example::chair_soup;
+use roar::{
     FinishConfig, InitConfig, LossConfig, OptimizeConfig, PipelineError, Prepared,
     ReconstructConfig, Reconstruction, ScheduledBlock, TargetConfig, default_loss,
 };
@@ -19,6 +19,9 @@ use roar_mesh::spatial::self_intersecting_faces;
 use roar_mesh::{Mesh, TrackedMesh};
 use roar_ops::blocks::block::{Block, BlockContext, BlockStats};
 use roar_ops::blocks::flips::{FlipOptions, flip_edges};
+
+/// Any error, as one line for the terminal.
+type Result<T, E = Box<dyn std::error::Error>> = std::result::Result<T, E>;
 
 /// A loss term of our own: the mean squared edge length (each edge counted once per face),
 /// which pulls the vertices towards even spacing. A [`Loss`] returns its value and its
@@ -84,7 +87,7 @@ fn loss_with_edge_term(prepared: &Prepared) -> Result<Box<dyn Loss>, PipelineErr
 /// The largest difference between `EdgeLength`'s gradient and central finite differences on
 /// `mesh`, relative to the largest gradient entry: a new loss term's gradient is checked
 /// before it drives a run.
-fn edge_length_gradient_error(mesh: &Mesh) -> anyhow::Result<f64> {
+fn edge_length_gradient_error(mesh: &Mesh) -> Result<f64> {
     let (positions, triangles) = mesh.to_triangles();
     let (_, grad) = EdgeLength.value_and_grad(&positions, &triangles)?;
     let scale = grad
@@ -106,13 +109,15 @@ fn edge_length_gradient_error(mesh: &Mesh) -> anyhow::Result<f64> {
     Ok(worst / scale)
 }
 
-fn main() -> anyhow::Result<()> {
+fn main() -> Result<()> {
     let output = std::env::args_os()
         .nth(1)
         .map_or_else(|| PathBuf::from("target/library.obj"), PathBuf::from);
 
     let error = edge_length_gradient_error(&roar_mesh::shapes::icosphere(2))?;
-    anyhow::ensure!(error < 1e-6, "edge-length gradient off by {error:e}");
+    if error >= 1e-6 {
+        return Err(format!("edge-length gradient off by {error:e}").into());
+    }
 
     // Toy settings (coarse init, 4 views of 64², 30 iterations) so the example runs in
     // seconds; `ReconstructConfig::default()` is what `roar reconstruct` uses.
@@ -180,10 +185,9 @@ fn main() -> anyhow::Result<()> {
     );
     // The pipeline's promises hold whatever the loss and blocks: `from_triangles` accepted a
     // closed, oriented 2-manifold; the budget is exact and no face crosses another.
-    anyhow::ensure!(
-        out.triangles.len() == reconstruction.config.faces && crossing == 0,
-        "the output breaks the pipeline's promises"
-    );
+    if out.triangles.len() != reconstruction.config.faces || crossing != 0 {
+        return Err("the output breaks the pipeline's promises".into());
+    }
     roar_io::write_mesh(&output, &TriangleSoup::new(out.positions, out.triangles))?;
     println!("wrote {}", output.display());
     Ok(())

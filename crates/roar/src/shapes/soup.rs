@@ -10,16 +10,17 @@ use std::borrow::Cow;
 
 use glam::DVec3;
 use roar_loss::{
-    InitialMesh, LossError, PointCloud, PointCloudOptions, Shape, ShapeError, ShapeSummary,
-    SharpEdgeOptions, Target, build_target, point_cloud, render_views, sharp_edge_samples,
-    two_sided_faces,
+    LossError, PointCloud, PointCloudOptions, SharpEdgeOptions, Target, build_target, point_cloud,
+    render_views, sharp_edge_samples, two_sided_faces,
 };
 use roar_mesh::Mesh;
 use roar_mesh::spatial::{Aabb, Normalization};
 use roar_ops::init::{InitOptions, InitialMeshOptions, ScannerView};
 use roar_render::{Camera, Image};
 
-use super::{ReconstructConfig, target_options};
+use crate::config::ReconstructConfig;
+use crate::rig::target_options;
+use crate::shape::{InitialMesh, Shape, ShapeError, ShapeSummary};
 
 /// A triangle soup (any coordinates, anything goes) and the configuration it is cleaned up,
 /// initialised and sampled with.

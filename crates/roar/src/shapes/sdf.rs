@@ -12,7 +12,9 @@ use std::borrow::Cow;
 use std::collections::BTreeMap;
 use std::sync::{Arc, Mutex};
 
-use roar_loss::{InitialMesh, LossError, PointCloud, Shape, ShapeError};
+use roar_loss::{LossError, PointCloud};
+
+use crate::shape::{InitialMesh, Shape, ShapeError};
 use roar_mesh::Mesh;
 use roar_mesh::spatial::{
     Aabb, Normalization, Projector, RIG_RADIUS, Sdf, SdfEvaluations, sample_surface,
@@ -22,7 +24,7 @@ use roar_render::{Camera, Image};
 use roar_sdf::{RigSdf, SdfProjector, SdfProjectorOptions, TraceOptions, TraceStats};
 use serde::Serialize;
 
-use super::ReconstructConfig;
+use crate::config::ReconstructConfig;
 
 /// The bounds an SDF input is reconstructed in when none are given: `[-1.1, 1.1]³`.
 pub const DEFAULT_BOUNDS: Aabb = roar_sdf::DEFAULT_BOUNDS;

@@ -4,7 +4,7 @@
 
 use std::borrow::Cow;
 
-use roar_loss::{KnnOptions, KnnPlanarProjector, Loss, LossError, PointCloud, Shape};
+use roar_loss::{KnnOptions, KnnPlanarProjector, Loss, LossError, PointCloud};
 use roar_mesh::spatial::Projector;
 use roar_mesh::{Mesh, TrackedMesh};
 use roar_ops::blocks::block::{BlockContext, BlockStats};
@@ -12,21 +12,25 @@ use roar_ops::optim::{Optimizer, OptimizerOptions};
 use roar_ops::untangle::{LimiterOptions, limit_steps};
 use roar_render::{Camera, Image};
 
-use super::prepare::Target;
-use super::{
-    IterationRecord, LossFactory, PipelineError, Prepared, ReconstructConfig, Run, RunStats,
-    ScheduledBlock, StageClock, coarse_rig_cameras,
-};
+use crate::config::ReconstructConfig;
+use crate::error::PipelineError;
+use crate::objective::{LossFactory, Prepared};
+use crate::report::{IterationRecord, RunStats};
+use crate::rig::coarse_rig_cameras;
+use crate::run::{Run, StageClock};
+use crate::schedule::ScheduledBlock;
+use crate::shape::Shape;
+use crate::stages::prepare::Target;
 
 /// The loss the loop minimizes and the k-NN planar projector over the point cloud (the
 /// blocks' projector unless the shape has its own, and the data flips' normals).
-pub(super) struct Objective {
+pub(crate) struct Objective {
     pub loss: Box<dyn Loss>,
     pub projector: KnnPlanarProjector,
 }
 
 /// Builds the objective from the shape's target renders and `cloud` with `loss_factory`.
-pub(super) fn objective(
+pub(crate) fn objective(
     shape: &dyn Shape,
     target: &Target,
     cloud: &PointCloud,
@@ -83,7 +87,7 @@ fn target_renders<'s>(
 /// blocks due), fewer when the loss levels off ([`levelled_off`]), and returns the states to
 /// finish from: the checkpoints, each with the loss before its iteration's step, and the last
 /// state with its loss (NaN when there is no checkpoint to compare it with).
-pub(super) fn optimize(
+pub(crate) fn optimize(
     mut mesh: Mesh,
     loss: &mut dyn Loss,
     block_projector: &dyn Projector,
@@ -202,14 +206,14 @@ fn levelled_off(states: &[LoopState], window: usize, tolerance: f64) -> bool {
 }
 
 /// A state of the loop's mesh and its loss.
-pub(super) struct LoopState {
+pub(crate) struct LoopState {
     pub iteration: usize,
     pub loss: f64,
     pub mesh: Mesh,
 }
 
 /// A fresh optimizer for `mesh` with the configured learning rate and Laplacian weight.
-pub(super) fn new_optimizer(
+pub(crate) fn new_optimizer(
     mesh: &Mesh,
     config: &ReconstructConfig,
 ) -> Result<Optimizer, PipelineError> {
@@ -227,7 +231,7 @@ pub(super) fn new_optimizer(
 /// One Move Vertices step (spec §3.2.4): the loss and its gradient on the compacted mesh, the
 /// optimizer step, then the step limiter if configured. Stage times go to `{stage}_loss`,
 /// `{stage}_step` and `{stage}_step_limiter`. Returns the loss before the step.
-pub(super) fn move_vertices(
+pub(crate) fn move_vertices(
     mesh: &mut Mesh,
     optimizer: &mut Optimizer,
     loss: &mut dyn Loss,

@@ -2,7 +2,7 @@
 //! and huge values are refused by `validate` (or by the TOML parser, for whole-number fields)
 //! exactly when the range says so, with a message naming the field, the value and the range.
 
-use roar_cli::pipeline::ReconstructConfig;
+use roar::ReconstructConfig;
 
 /// The default configuration with `key` (`faces`, or `table.leaf` as the ranges name it) set to
 /// `value`, parsed as a user's TOML file would be.

@@ -5,7 +5,7 @@
 //! `cargo run --release -p roar-cli --example loss_balance -- MESH [FACES]`
 
 use glam::DVec3;
-use roar_cli::pipeline::ReconstructConfig;
+use roar::ReconstructConfig;
 use roar_loss::{
     Loss, PlanarLoss, PlanarOptions, PointCloudOptions, RenderLoss, TargetOptions, build_target,
     point_cloud,
@@ -13,11 +13,14 @@ use roar_loss::{
 use roar_ops::decimate::{DecimateOptions, decimate};
 use roar_ops::init::{InitialMeshOptions, initial_mesh};
 
+/// Any error, as one line for the terminal.
+type Result<T, E = Box<dyn std::error::Error>> = std::result::Result<T, E>;
+
 fn mean_norm(g: &[DVec3]) -> f64 {
     g.iter().map(|v| v.length()).sum::<f64>() / g.len() as f64
 }
 
-fn main() -> anyhow::Result<()> {
+fn main() -> Result<()> {
     let args: Vec<String> = std::env::args().collect();
     let path = args.get(1).expect("usage: loss_balance MESH [FACES]");
     let faces: usize = args.get(2).map_or(Ok(5000), |f| f.parse())?;

@@ -1,21 +1,26 @@
 //! The init stage: M0 (the shape's initial mesh, or a sphere), the budget check against its
 //! pieces, the target point cloud P, and M0 decimated to the working budget W.
 
-use roar_loss::{LossError, PointCloud, Shape};
+use roar_loss::{LossError, PointCloud};
 use roar_mesh::Mesh;
 use roar_ops::decimate::{DecimateOptions, decimate};
 
-use super::{InitKind, PipelineError, ReconstructConfig, Run, RunStats};
+use crate::budget::{check_budget, smallest_budget};
+use crate::config::{InitKind, ReconstructConfig};
+use crate::error::PipelineError;
+use crate::report::RunStats;
+use crate::run::Run;
+use crate::shape::Shape;
 
 /// M0 at the working budget and the shape's point cloud for it.
-pub(super) fn init(shape: &dyn Shape, run: &mut Run) -> Result<(Mesh, PointCloud), PipelineError> {
+pub(crate) fn init(shape: &dyn Shape, run: &mut Run) -> Result<(Mesh, PointCloud), PipelineError> {
     let config = run.config;
     run.report("init", 0, f64::NAN, 0)?;
     let mut mesh = initial_mesh(shape, config, &mut run.stats)?;
-    crate::budget::check_budget(
+    check_budget(
         "faces =",
         config.faces,
-        crate::budget::min_reachable_budget(&mesh.component_genera(), config.finish.keep_topology),
+        smallest_budget(&mesh.component_genera(), config.finish.keep_topology),
     )
     .map_err(|e| PipelineError::Config(format!("{e} (for the pieces of the init)")))?;
     run.clock.lap("init");

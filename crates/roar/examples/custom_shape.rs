@@ -11,15 +11,19 @@ use std::f64::consts::TAU;
 use std::path::PathBuf;
 
 use glam::DVec3;
-use roar_cli::pipeline::{
+use roar::{
     FinishConfig, LossConfig, OptimizeConfig, ReconstructConfig, Reconstruction, TargetConfig,
 };
+use roar::{InitialMesh, Shape, ShapeError};
 use roar_io::TriangleSoup;
-use roar_loss::{InitialMesh, PointCloud, Shape, ShapeError, render_views};
+use roar_loss::{PointCloud, render_views};
 use roar_mesh::Mesh;
 use roar_mesh::shapes::torus;
 use roar_mesh::spatial::{Normalization, RIG_RADIUS};
 use roar_render::{Camera, Image};
+
+/// Any error, as one line for the terminal.
+type Result<T, E = Box<dyn std::error::Error>> = std::result::Result<T, E>;
 
 /// The torus around the z axis through `center`, with tube centre `major` and tube radius
 /// `minor`, in the input's (here: made-up world) coordinates.
@@ -99,7 +103,7 @@ impl Shape for AnalyticTorus {
     }
 }
 
-fn main() -> anyhow::Result<()> {
+fn main() -> Result<()> {
     let output = std::env::args_os()
         .nth(1)
         .map_or_else(|| PathBuf::from("target/custom_shape.obj"), PathBuf::from);

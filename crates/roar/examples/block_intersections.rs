@@ -4,7 +4,7 @@
 //! `cargo run --release -p roar-cli --example block_intersections -- FILE [FACES] [RESOLUTION]`.
 //! Diagnostic only: the exact all-pairs check after every block makes the run much slower.
 
-use roar_cli::pipeline::{InitConfig, ReconstructConfig, Reconstruction, ScheduledBlock};
+use roar::{InitConfig, ReconstructConfig, Reconstruction, ScheduledBlock};
 use roar_mesh::TrackedMesh;
 use roar_mesh::spatial::count_intersecting_faces;
 use roar_ops::blocks::block::{Block, BlockContext, BlockStats};

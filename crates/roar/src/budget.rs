@@ -10,7 +10,7 @@ use roar_ops::decimate::minimum_faces_for_genus;
 /// `keep_topology`, the sum of each piece's minimum (`2(V − 2 + 2g)` with Heawood's vertex
 /// bound); otherwise handles may be removed and each piece needs a tetrahedron's 4 faces
 /// (`roar_ops::finish::genus::min_reachable_budget`). 0 pieces → 0.
-pub fn min_reachable_budget(genera: &[usize], keep_topology: bool) -> usize {
+pub fn smallest_budget(genera: &[usize], keep_topology: bool) -> usize {
     if keep_topology {
         genera.iter().copied().map(minimum_faces_for_genus).sum()
     } else {
@@ -18,33 +18,59 @@ pub fn min_reachable_budget(genera: &[usize], keep_topology: bool) -> usize {
     }
 }
 
-/// Checks `faces` against the smallest budget `minimum` (even, ≥ 4) before any work; the error
-/// suggests only budgets that work: the nearest even counts at or above `minimum`.
-pub fn check_budget(flag: &str, faces: usize, minimum: usize) -> Result<(), String> {
+/// A face budget no mesh of the pieces at hand can have. Its message names only budgets that
+/// work: the nearest even counts at or above `minimum`.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error("{what} {faces} {}; {}", self.why(), self.advice())]
+pub struct BudgetError {
+    /// How the user gave the budget (`--faces`, `faces =`), for the message.
+    pub what: &'static str,
+    /// The budget asked for.
+    pub faces: usize,
+    /// The smallest budget that works (even, at least 4).
+    pub minimum: usize,
+}
+
+impl BudgetError {
+    fn why(&self) -> String {
+        if self.faces < self.minimum {
+            format!(
+                "is below the smallest reachable budget, {} faces",
+                self.minimum
+            )
+        } else {
+            "is odd, but a closed triangle mesh always has an even face count".to_string()
+        }
+    }
+
+    fn advice(&self) -> String {
+        let below = self.faces - self.faces % 2;
+        if below >= self.minimum && below != self.faces {
+            format!("use {below} or {}", below + 2)
+        } else {
+            format!("use {}", self.minimum.max(self.faces + self.faces % 2))
+        }
+    }
+}
+
+/// Checks `faces` against the smallest budget `minimum` (raised to 4) before any work: it must be
+/// even and at least `minimum`.
+pub fn check_budget(what: &'static str, faces: usize, minimum: usize) -> Result<(), BudgetError> {
     let minimum = minimum.max(4);
     if faces >= minimum && faces.is_multiple_of(2) {
         return Ok(());
     }
-    let why = if faces < minimum {
-        format!("is below the smallest reachable budget, {minimum} faces")
-    } else {
-        "is odd, but a closed triangle mesh always has an even face count".to_string()
-    };
-    let below = faces - faces % 2;
-    let advice = if below >= minimum && below != faces {
-        format!("use {below} or {}", below + 2)
-    } else {
-        format!("use {}", minimum.max(faces + faces % 2))
-    };
-    Err(format!("{flag} {faces} {why}; {advice}"))
+    Err(BudgetError {
+        what,
+        faces,
+        minimum,
+    })
 }
 
-/// A clap value parser for `--faces`: a non-negative whole number, with a message that says so
-/// for `-10` or `ten` (clap would otherwise read `-10` as the flags `-1 -0`).
-pub fn parse_faces(text: &str) -> Result<usize, String> {
-    text.trim()
-        .parse::<usize>()
-        .map_err(|_| format!("{text:?} is not a face count (a positive even whole number)"))
+/// Refuses a face budget no closed mesh can have, up front: odd (3F = 2E) or below the 4 faces
+/// of a tetrahedron.
+pub fn check_even_budget(faces: usize) -> Result<(), BudgetError> {
+    check_budget("--faces", faces, 4)
 }
 
 /// Bytes a reconstruction is expected to need at its peak, from the sizes that drive it: the
@@ -98,13 +124,13 @@ mod tests {
 
     #[test]
     fn smallest_budgets_of_spheres_tori_and_several_pieces() {
-        assert_eq!(min_reachable_budget(&[0], true), 4);
-        assert_eq!(min_reachable_budget(&[1], true), 14);
-        assert_eq!(min_reachable_budget(&[1], false), 4);
-        assert_eq!(min_reachable_budget(&[2, 0], false), 8);
-        assert_eq!(min_reachable_budget(&[0, 0], true), 8);
-        assert_eq!(min_reachable_budget(&[0, 1], true), 18);
-        assert_eq!(min_reachable_budget(&[], true), 0);
+        assert_eq!(smallest_budget(&[0], true), 4);
+        assert_eq!(smallest_budget(&[1], true), 14);
+        assert_eq!(smallest_budget(&[1], false), 4);
+        assert_eq!(smallest_budget(&[2, 0], false), 8);
+        assert_eq!(smallest_budget(&[0, 0], true), 8);
+        assert_eq!(smallest_budget(&[0, 1], true), 18);
+        assert_eq!(smallest_budget(&[], true), 0);
     }
 
     #[test]
@@ -118,7 +144,9 @@ mod tests {
             (9, 8, "use 8 or 10"),
             (13, 14, "use 14"),
         ] {
-            let message = check_budget("--faces", faces, minimum).unwrap_err();
+            let message = check_budget("--faces", faces, minimum)
+                .unwrap_err()
+                .to_string();
             assert!(message.ends_with(advice), "{faces}: {message}");
             let suggested: Vec<usize> = message
                 .rsplit("use ")
@@ -133,12 +161,5 @@ mod tests {
         }
         check_budget("--faces", 4, 4).unwrap();
         check_budget("--faces", 5000, 8).unwrap();
-    }
-
-    #[test]
-    fn parse_faces_explains_negative_numbers() {
-        assert_eq!(parse_faces("5000"), Ok(5000));
-        assert!(parse_faces("-10").unwrap_err().contains("not a face count"));
-        assert!(parse_faces("ten").is_err());
     }
 }
