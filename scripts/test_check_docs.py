@@ -13,6 +13,7 @@ import unittest
 HERE = os.path.dirname(os.path.abspath(__file__))
 SCRIPT = os.path.join(HERE, 'check-docs.py')
 
+sys.dont_write_bytecode = True  # no __pycache__ beside the scripts
 _spec = importlib.util.spec_from_file_location('check_docs', SCRIPT)
 cd = importlib.util.module_from_spec(_spec)
 _spec.loader.exec_module(cd)

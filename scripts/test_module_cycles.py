@@ -17,6 +17,7 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 REPO = os.path.dirname(HERE)
 SCRIPT = os.path.join(HERE, 'module-cycles.py')
 
+sys.dont_write_bytecode = True  # no __pycache__ beside the scripts
 _spec = importlib.util.spec_from_file_location('module_cycles', SCRIPT)
 mc = importlib.util.module_from_spec(_spec)
 _spec.loader.exec_module(mc)
