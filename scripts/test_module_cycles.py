@@ -563,7 +563,10 @@ class RealTreeOfE673cf8(unittest.TestCase):
         tar = subprocess.run(['git', '-C', REPO, 'archive', '--format=tar', 'e673cf8',
                               'crates/roar-cli/src'], capture_output=True, check=True).stdout
         with tarfile.open(fileobj=io.BytesIO(tar)) as t:
-            t.extractall(tmp.name, filter='data')
+            if hasattr(tarfile, 'data_filter'):  # Python 3.11.4 and later
+                t.extractall(tmp.name, filter='data')
+            else:
+                t.extractall(tmp.name)
         root = os.path.join(tmp.name, 'crates', 'roar-cli', 'src')
         code, out = run_script(root)
         self.assertEqual(code, 1, out)
