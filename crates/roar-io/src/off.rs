@@ -4,20 +4,24 @@
 //! `CNOFF`, `STOFF`, ...), the counts line `V F [E]` (on its own line or after the keyword),
 //! one vertex per line (first three numbers are the position; colours, normals and texture
 //! coordinates after them are ignored), one face per line `k i1 .. ik [colour]` with 0-based
-//! indices (polygons are fan-triangulated), `#` comments and blank lines anywhere.
+//! indices (polygons are triangulated; faces of fewer than 3 corners are skipped and counted),
+//! `#` comments and blank lines anywhere.
 //! Not accepted (clear error): binary OFF, `4OFF` and `nOFF` (not 3-D).
 
 use std::io::Write;
 
 use crate::error::IoError;
 use crate::soup::TriangleSoup;
-use crate::text::{FanBuilder, lines, parse_i64, parse_point, show, strip_comment, tokens};
+use crate::text::{
+    FanBuilder, lines, parse_i64, parse_point, show, skipped_note, strip_comment, tokens,
+};
 
 /// Reads an OFF file from `bytes`; `file` names it in errors.
 ///
 /// Errors (with the 1-based line): a missing or unknown header, bad counts, malformed or
-/// non-finite coordinates, faces with fewer than 3 corners or indices out of range, a file that
-/// ends before all declared vertices and faces, and no triangles.
+/// non-finite coordinates, face indices out of range, a file that ends before all declared
+/// vertices and faces, and no triangles. Faces with fewer than 3 corners are skipped and counted
+/// in [`TriangleSoup::n_faces_skipped`].
 pub fn read_off(bytes: &[u8], file: &str) -> Result<TriangleSoup, IoError> {
     // Meaningful lines only: comments stripped, blank lines skipped.
     let mut content = lines(bytes)
@@ -106,11 +110,11 @@ pub fn read_off(bytes: &[u8], file: &str) -> Result<TriangleSoup, IoError> {
                 format!("face corner count {:?} is not an integer", show(first)),
             )
         })?;
-        if k < 3 {
+        if k < 0 {
             return Err(IoError::at_line(
                 file,
                 n,
-                format!("face has {k} corner(s); at least 3 are needed"),
+                format!("face corner count {k} is negative"),
             ));
         }
         corners.clear();
@@ -138,19 +142,17 @@ pub fn read_off(bytes: &[u8], file: &str) -> Result<TriangleSoup, IoError> {
             }
             corners.push(i as u32);
         }
+        // A face of fewer than 3 corners is skipped and counted by the builder.
         fans.push_face(&corners);
     }
 
     if fans.is_empty() {
-        return Err(IoError::in_file(file, "mesh has no faces"));
+        return Err(IoError::in_file(
+            file,
+            format!("mesh has no faces{}", skipped_note(fans.skipped())),
+        ));
     }
-    let faces = fans.finish(&positions);
-    Ok(TriangleSoup {
-        positions,
-        triangles: faces.triangles,
-        n_polygons: faces.n_polygons,
-        n_polygons_unclean: faces.n_polygons_unclean,
-    })
+    Ok(fans.finish(&positions).into_soup(positions))
 }
 
 /// Accepts `OFF` with optional `ST`, `C`, `N` prefixes in that order.
@@ -215,7 +217,7 @@ mod tests {
 
     #[test]
     fn errors_name_file_and_line() {
-        let cases: [(&[u8], &str); 7] = [
+        let cases: [(&[u8], &str); 8] = [
             (b"PLY\n3 1 0\n", "t.off:1: not an OFF file"),
             (b"4OFF\n3 1 0\n", "t.off:1: \"4OFF\": only 3-D"),
             (
@@ -232,9 +234,13 @@ mod tests {
             ),
             (
                 b"OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n2 0 1\n",
-                "t.off:6: face has 2 corner(s)",
+                "t.off: mesh has no faces; 1 face(s) with fewer than 3 corners skipped",
             ),
             (b"OFF\n0 0 0\n", "t.off: mesh has no faces"),
+            (
+                b"OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n-1 0\n",
+                "t.off:6: face corner count -1 is negative",
+            ),
         ];
         for (text, want) in cases {
             let e = read_off(text, "t.off").unwrap_err().to_string();
