@@ -1,11 +1,12 @@
 //! OFF (Object File Format): reader and writer.
 //!
 //! Accepted: a header keyword `OFF` with optional `ST`, `C`, `N` prefixes (`COFF`, `NOFF`,
-//! `CNOFF`, `STOFF`, ...), the counts line `V F [E]` (on its own line or after the keyword),
-//! one vertex per line (first three numbers are the position; colours, normals and texture
-//! coordinates after them are ignored), one face per line `k i1 .. ik [colour]` with 0-based
-//! indices (polygons are triangulated; faces of fewer than 3 corners are skipped and counted),
-//! `#` comments and blank lines anywhere.
+//! `CNOFF`, `STOFF`, ...), the counts line `V F [E]` (on its own line or after the keyword, even
+//! with `V` glued to it as ModelNet40 writes it: `OFF700 620 0`), one vertex per line (first
+//! three numbers are the position; colours, normals and texture coordinates after them are
+//! ignored), one face per line `k i1 .. ik [colour]` with 0-based indices (polygons are
+//! triangulated; faces of fewer than 3 corners are skipped and counted), `#` comments and blank
+//! lines anywhere.
 //! Not accepted (clear error): binary OFF, `4OFF` and `nOFF` (not 3-D).
 
 use std::io::Write;
@@ -32,11 +33,12 @@ pub fn read_off(bytes: &[u8], file: &str) -> Result<TriangleSoup, IoError> {
         .next()
         .ok_or_else(|| IoError::in_file(file, "file is empty (expected an OFF header)"))?;
     let mut toks = tokens(header);
-    let keyword = toks.next().unwrap_or_default();
+    let (keyword, glued) = split_glued_count(toks.next().unwrap_or_default());
     check_keyword(file, header_line, keyword)?;
 
-    // The counts follow the keyword on the same line, or come on the next line.
-    let mut rest: Vec<&[u8]> = toks.collect();
+    // The counts follow the keyword on the same line (the vertex count possibly glued to it),
+    // or come on the next line.
+    let mut rest: Vec<&[u8]> = glued.into_iter().chain(toks).collect();
     if rest
         .first()
         .is_some_and(|t| t.eq_ignore_ascii_case(b"BINARY"))
@@ -155,6 +157,21 @@ pub fn read_off(bytes: &[u8], file: &str) -> Result<TriangleSoup, IoError> {
     Ok(fans.finish(&positions).into_soup(positions))
 }
 
+/// Splits a vertex count glued to the keyword (`OFF700` as ModelNet40 writes it, also `COFF12`)
+/// into the keyword and the count, as mainstream loaders read it; any other token is returned
+/// whole, for [`check_keyword`] to judge.
+fn split_glued_count(token: &[u8]) -> (&[u8], Option<&[u8]>) {
+    let Some(at) = token.windows(3).position(|w| w == b"OFF") else {
+        return (token, None);
+    };
+    let (keyword, count) = token.split_at(at + 3);
+    if !count.is_empty() && count.iter().all(u8::is_ascii_digit) {
+        (keyword, Some(count))
+    } else {
+        (token, None)
+    }
+}
+
 /// Accepts `OFF` with optional `ST`, `C`, `N` prefixes in that order.
 fn check_keyword(file: &str, line: usize, keyword: &[u8]) -> Result<(), IoError> {
     let bad = || {
@@ -217,7 +234,7 @@ mod tests {
 
     #[test]
     fn errors_name_file_and_line() {
-        let cases: [(&[u8], &str); 8] = [
+        let cases: [(&[u8], &str); 11] = [
             (b"PLY\n3 1 0\n", "t.off:1: not an OFF file"),
             (b"4OFF\n3 1 0\n", "t.off:1: \"4OFF\": only 3-D"),
             (
@@ -241,6 +258,12 @@ mod tests {
                 b"OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n-1 0\n",
                 "t.off:6: face corner count -1 is negative",
             ),
+            (
+                b"OFFx3 1 0\n",
+                "t.off:1: not an OFF file: header is \"OFFx3\"",
+            ),
+            (b"4OFF3 1 0\n", "t.off:1: \"4OFF\": only 3-D"),
+            (b"OFF3\n1 0\n", "t.off:1: missing face count"),
         ];
         for (text, want) in cases {
             let e = read_off(text, "t.off").unwrap_err().to_string();

@@ -106,3 +106,22 @@ fn skipped_face_counts_survive_welding() {
     let (welded, _) = read("w.obj", obj.as_bytes()).welded();
     assert_eq!(welded.n_faces_skipped, 1);
 }
+
+#[test]
+fn off_headers_with_the_vertex_count_glued_to_the_keyword_read() {
+    // ModelNet40 writes `OFF700 620 0`: the vertex count glued to the keyword, the other counts
+    // after it (here with extra spaces and a tab), and the same for the keyword's variants.
+    let body = "0 0 0\n1 0 0\n1 1 0\n0 1 0\n3 0 1 2\n3 0 2 3\n";
+    for header in [
+        "OFF4 2 0",
+        "OFF4   2\t0  ",
+        "OFF4 2",
+        "COFF4 2 0",
+        "NOFF4 2 0",
+        "CNOFF4 2 0",
+    ] {
+        let soup = read("g.off", format!("{header}\n{body}").as_bytes());
+        assert_eq!(soup.positions.len(), 4, "{header:?}");
+        assert_eq!(soup.triangles, [[0, 1, 2], [0, 2, 3]], "{header:?}");
+    }
+}
