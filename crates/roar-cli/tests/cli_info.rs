@@ -88,6 +88,24 @@ fn info_names_the_first_reason_a_soup_is_not_manifold() {
 }
 
 #[test]
+fn info_reports_faces_with_fewer_than_three_corners_as_skipped() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("lines.obj");
+    std::fs::write(&path, "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nf 1 2\nf 2 3\n").unwrap();
+    let output = roar(&["info", "--json", path.to_str().unwrap()]);
+    assert!(output.status.success(), "{output:?}");
+    let json: serde_json::Value = serde_json::from_slice(&output.stdout).unwrap();
+    assert_eq!(json["faces"], 1);
+    assert_eq!(json["faces_skipped"], 2);
+    let output = roar(&["info", path.to_str().unwrap()]);
+    let text = String::from_utf8_lossy(&output.stdout);
+    assert!(
+        text.contains("skipped   2 face(s) with fewer than 3 corners"),
+        "{text}"
+    );
+}
+
+#[test]
 fn bad_input_gives_one_line_and_a_non_zero_exit() {
     let dir = tempfile::tempdir().unwrap();
     let garbage = dir.path().join("garbage.ply");

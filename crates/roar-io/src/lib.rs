@@ -19,9 +19,11 @@
 //!   triangle, finite coordinates, indices in range. Polygons are triangulated in their plane by
 //!   ear clipping (in one place for every reader: convex ones stay fans, concave ones get no
 //!   overlapping triangles) and counted in [`TriangleSoup::n_polygons`], those that could not be
-//!   triangulated cleanly in [`TriangleSoup::n_polygons_unclean`]; degenerate triangles (repeated indices) are kept. Vertices are
-//!   numbered as in the file (OBJ: globally across groups); nothing is welded unless you call
-//!   [`TriangleSoup::welded`].
+//!   triangulated cleanly in [`TriangleSoup::n_polygons_unclean`]. Faces of fewer than 3
+//!   corners bound no surface: they are skipped and counted in
+//!   [`TriangleSoup::n_faces_skipped`], not refused. Degenerate triangles (repeated indices,
+//!   zero area) are kept. Vertices are numbered as in the file (OBJ: globally across groups);
+//!   nothing is welded unless you call [`TriangleSoup::welded`].
 //! * Malformed input never panics: it gives an [`IoError`] whose one-line message names the file
 //!   and, where it applies, the line (`bunny.obj:1234: ...`) or element (`x.stl: triangle 7: ...`).
 //! * Written coordinates read back bit-identical in OBJ, OFF, PLY and ASCII STL (shortest

@@ -2,20 +2,24 @@
 //!
 //! Reading keeps the file's global vertex numbering across `o`/`g` groups (tools that count
 //! topology "by index" see exactly the file's vertices), resolves negative (relative) indices,
-//! takes the position part of `f a/b/c` corners, fan-triangulates polygons, and ignores
-//! everything else (`vt vn vp l p o g s mtllib usemtl`, comments, vertex colours and `w`
-//! after `v x y z`). Material libraries are never opened, so a missing `.mtl` does not matter.
+//! takes the position part of `f a/b/c` corners, triangulates polygons, skips (and counts) faces
+//! of fewer than 3 corners, and ignores everything else (`vt vn vp l p o g s mtllib usemtl`,
+//! comments, vertex colours and `w` after `v x y z`). Material libraries are never opened, so a
+//! missing `.mtl` does not matter.
 
 use std::io::Write;
 
 use crate::error::IoError;
 use crate::soup::TriangleSoup;
-use crate::text::{FanBuilder, lines, parse_i64, parse_point, show, strip_comment, tokens};
+use crate::text::{
+    FanBuilder, lines, parse_i64, parse_point, show, skipped_note, strip_comment, tokens,
+};
 
 /// Reads an OBJ file's positions and faces from `bytes`; `file` names it in errors.
 ///
-/// Errors (with the 1-based line): malformed or non-finite coordinates, a face with fewer than 3
-/// corners, index 0, an index outside the file's vertices; and no triangles at all.
+/// Errors (with the 1-based line): malformed or non-finite coordinates, index 0, an index outside
+/// the file's vertices; and no triangles at all. Faces with fewer than 3 corners are skipped and
+/// counted in [`TriangleSoup::n_faces_skipped`].
 pub fn read_obj(bytes: &[u8], file: &str) -> Result<TriangleSoup, IoError> {
     let mut positions = Vec::new();
     let mut fans = FanBuilder::default();
@@ -75,16 +79,7 @@ pub fn read_obj(bytes: &[u8], file: &str) -> Result<TriangleSoup, IoError> {
                     }
                     corners.push(zero_based as u32);
                 }
-                if corners.len() < 3 {
-                    return Err(IoError::at_line(
-                        file,
-                        line_no,
-                        format!(
-                            "face has {} corner(s); at least 3 are needed",
-                            corners.len()
-                        ),
-                    ));
-                }
+                // A face of fewer than 3 corners is skipped and counted by the builder.
                 fans.push_face(&corners);
             }
             // vt vn vp l p o g s mtllib usemtl and other statements carry nothing we keep.
@@ -111,18 +106,13 @@ pub fn read_obj(bytes: &[u8], file: &str) -> Result<TriangleSoup, IoError> {
         return Err(IoError::in_file(
             file,
             format!(
-                "no faces found ({} vertices); empty or not an OBJ mesh",
-                positions.len()
+                "no faces found ({} vertices{}); empty or not an OBJ mesh",
+                positions.len(),
+                skipped_note(fans.skipped())
             ),
         ));
     }
-    let faces = fans.finish(&positions);
-    Ok(TriangleSoup {
-        positions,
-        triangles: faces.triangles,
-        n_polygons: faces.n_polygons,
-        n_polygons_unclean: faces.n_polygons_unclean,
-    })
+    Ok(fans.finish(&positions).into_soup(positions))
 }
 
 /// Writes `soup` as OBJ (`v` lines, then `f` lines with 1-based indices). Coordinates use Rust's
@@ -190,7 +180,7 @@ f 1/1/1 2/1/1 3/1/1 4/1/1\r\nf -4//1 -2//1 -1//1\r\nl 1 2\r\n";
             (b"v 0 0 0\nv 1 0\n", "t.obj:2: missing z"),
             (
                 b"v 0 0 0\nv 1 0 0\nf 1 2\n",
-                "t.obj:3: face has 2 corner(s)",
+                "t.obj: no faces found (2 vertices; 1 face(s) with fewer than 3 corners skipped)",
             ),
             (b"v 0 0 0\n", "t.obj: no faces found"),
         ];

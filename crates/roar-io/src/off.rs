@@ -1,23 +1,28 @@
 //! OFF (Object File Format): reader and writer.
 //!
 //! Accepted: a header keyword `OFF` with optional `ST`, `C`, `N` prefixes (`COFF`, `NOFF`,
-//! `CNOFF`, `STOFF`, ...), the counts line `V F [E]` (on its own line or after the keyword),
-//! one vertex per line (first three numbers are the position; colours, normals and texture
-//! coordinates after them are ignored), one face per line `k i1 .. ik [colour]` with 0-based
-//! indices (polygons are fan-triangulated), `#` comments and blank lines anywhere.
+//! `CNOFF`, `STOFF`, ...), the counts line `V F [E]` (on its own line or after the keyword, even
+//! with `V` glued to it as ModelNet40 writes it: `OFF700 620 0`), one vertex per line (first
+//! three numbers are the position; colours, normals and texture coordinates after them are
+//! ignored), one face per line `k i1 .. ik [colour]` with 0-based indices (polygons are
+//! triangulated; faces of fewer than 3 corners are skipped and counted), `#` comments and blank
+//! lines anywhere.
 //! Not accepted (clear error): binary OFF, `4OFF` and `nOFF` (not 3-D).
 
 use std::io::Write;
 
 use crate::error::IoError;
 use crate::soup::TriangleSoup;
-use crate::text::{FanBuilder, lines, parse_i64, parse_point, show, strip_comment, tokens};
+use crate::text::{
+    FanBuilder, lines, parse_i64, parse_point, show, skipped_note, strip_comment, tokens,
+};
 
 /// Reads an OFF file from `bytes`; `file` names it in errors.
 ///
 /// Errors (with the 1-based line): a missing or unknown header, bad counts, malformed or
-/// non-finite coordinates, faces with fewer than 3 corners or indices out of range, a file that
-/// ends before all declared vertices and faces, and no triangles.
+/// non-finite coordinates, face indices out of range, a file that ends before all declared
+/// vertices and faces, and no triangles. Faces with fewer than 3 corners are skipped and counted
+/// in [`TriangleSoup::n_faces_skipped`].
 pub fn read_off(bytes: &[u8], file: &str) -> Result<TriangleSoup, IoError> {
     // Meaningful lines only: comments stripped, blank lines skipped.
     let mut content = lines(bytes)
@@ -28,11 +33,12 @@ pub fn read_off(bytes: &[u8], file: &str) -> Result<TriangleSoup, IoError> {
         .next()
         .ok_or_else(|| IoError::in_file(file, "file is empty (expected an OFF header)"))?;
     let mut toks = tokens(header);
-    let keyword = toks.next().unwrap_or_default();
+    let (keyword, glued) = split_glued_count(toks.next().unwrap_or_default());
     check_keyword(file, header_line, keyword)?;
 
-    // The counts follow the keyword on the same line, or come on the next line.
-    let mut rest: Vec<&[u8]> = toks.collect();
+    // The counts follow the keyword on the same line (the vertex count possibly glued to it),
+    // or come on the next line.
+    let mut rest: Vec<&[u8]> = glued.into_iter().chain(toks).collect();
     if rest
         .first()
         .is_some_and(|t| t.eq_ignore_ascii_case(b"BINARY"))
@@ -106,11 +112,11 @@ pub fn read_off(bytes: &[u8], file: &str) -> Result<TriangleSoup, IoError> {
                 format!("face corner count {:?} is not an integer", show(first)),
             )
         })?;
-        if k < 3 {
+        if k < 0 {
             return Err(IoError::at_line(
                 file,
                 n,
-                format!("face has {k} corner(s); at least 3 are needed"),
+                format!("face corner count {k} is negative"),
             ));
         }
         corners.clear();
@@ -138,19 +144,32 @@ pub fn read_off(bytes: &[u8], file: &str) -> Result<TriangleSoup, IoError> {
             }
             corners.push(i as u32);
         }
+        // A face of fewer than 3 corners is skipped and counted by the builder.
         fans.push_face(&corners);
     }
 
     if fans.is_empty() {
-        return Err(IoError::in_file(file, "mesh has no faces"));
+        return Err(IoError::in_file(
+            file,
+            format!("mesh has no faces{}", skipped_note(fans.skipped())),
+        ));
     }
-    let faces = fans.finish(&positions);
-    Ok(TriangleSoup {
-        positions,
-        triangles: faces.triangles,
-        n_polygons: faces.n_polygons,
-        n_polygons_unclean: faces.n_polygons_unclean,
-    })
+    Ok(fans.finish(&positions).into_soup(positions))
+}
+
+/// Splits a vertex count glued to the keyword (`OFF700` as ModelNet40 writes it, also `COFF12`)
+/// into the keyword and the count, as mainstream loaders read it; any other token is returned
+/// whole, for [`check_keyword`] to judge.
+fn split_glued_count(token: &[u8]) -> (&[u8], Option<&[u8]>) {
+    let Some(at) = token.windows(3).position(|w| w == b"OFF") else {
+        return (token, None);
+    };
+    let (keyword, count) = token.split_at(at + 3);
+    if !count.is_empty() && count.iter().all(u8::is_ascii_digit) {
+        (keyword, Some(count))
+    } else {
+        (token, None)
+    }
 }
 
 /// Accepts `OFF` with optional `ST`, `C`, `N` prefixes in that order.
@@ -215,7 +234,7 @@ mod tests {
 
     #[test]
     fn errors_name_file_and_line() {
-        let cases: [(&[u8], &str); 7] = [
+        let cases: [(&[u8], &str); 11] = [
             (b"PLY\n3 1 0\n", "t.off:1: not an OFF file"),
             (b"4OFF\n3 1 0\n", "t.off:1: \"4OFF\": only 3-D"),
             (
@@ -232,9 +251,19 @@ mod tests {
             ),
             (
                 b"OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n2 0 1\n",
-                "t.off:6: face has 2 corner(s)",
+                "t.off: mesh has no faces; 1 face(s) with fewer than 3 corners skipped",
             ),
             (b"OFF\n0 0 0\n", "t.off: mesh has no faces"),
+            (
+                b"OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n-1 0\n",
+                "t.off:6: face corner count -1 is negative",
+            ),
+            (
+                b"OFFx3 1 0\n",
+                "t.off:1: not an OFF file: header is \"OFFx3\"",
+            ),
+            (b"4OFF3 1 0\n", "t.off:1: \"4OFF\": only 3-D"),
+            (b"OFF3\n1 0\n", "t.off:1: missing face count"),
         ];
         for (text, want) in cases {
             let e = read_off(text, "t.off").unwrap_err().to_string();

@@ -5,7 +5,8 @@
 //! element, so elements and properties it does not need (colours, confidence, normals, edges,
 //! materials, lists included) are skipped correctly. It keeps the `vertex` element's `x y z`
 //! (any scalar type) and the `face` element's `vertex_indices` (or `vertex_index`) list (any
-//! integer count and index type); polygons are fan-triangulated.
+//! integer count and index type); polygons are triangulated, faces of fewer than 3 corners are
+//! skipped and counted.
 //!
 //! A range image (`obj_info num_cols C` / `num_rows R` and an `element range_grid` of `C·R`
 //! lists holding no index or one vertex index, row-major, the Stanford scans' layout) is read
@@ -21,7 +22,7 @@ use std::io::Write;
 
 use crate::error::{IoError, Location};
 use crate::soup::TriangleSoup;
-use crate::text::{FanBuilder, parse_f64, parse_i64, show, tokens};
+use crate::text::{FanBuilder, parse_f64, parse_i64, show, skipped_note, tokens};
 
 /// The three PLY encodings.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -146,19 +147,14 @@ struct PlyBody {
 /// Reads a PLY file in any of the three encodings; `file` names it in errors.
 ///
 /// Errors: a malformed header (with its line), a missing `vertex` element or `x y z`, a missing
-/// face list, truncated bodies, malformed numbers, NaN/inf coordinates, face indices out of
-/// range and faces with fewer than 3 corners (with the line for ASCII, the element index for
-/// binary), and no triangles.
+/// face list, truncated bodies, malformed numbers, NaN/inf coordinates and face indices out of
+/// range (with the line for ASCII, the element index for binary), and no triangles. Faces with
+/// fewer than 3 corners are skipped and counted in [`TriangleSoup::n_faces_skipped`].
 pub fn read_ply(bytes: &[u8], file: &str) -> Result<TriangleSoup, IoError> {
     let body = read_ply_body(bytes, file)?;
     let (cells, [cols, rows]) = match (body.faces, body.grid) {
         (Some(faces), _) => {
-            return Ok(TriangleSoup {
-                positions: body.positions,
-                triangles: faces.triangles,
-                n_polygons: faces.n_polygons,
-                n_polygons_unclean: faces.n_polygons_unclean,
-            });
+            return Ok(faces.into_soup(body.positions));
         }
         (None, Some(grid)) => grid,
         (None, None) => {
@@ -640,14 +636,8 @@ fn read_body(
                             }
                         }
                         match role {
-                            Role::Face(q) if q == p => {
-                                if k < 3 {
-                                    let msg =
-                                        format!("face has {k} corner(s); at least 3 are needed");
-                                    return Err(fail(&src, msg));
-                                }
-                                fans.push_face(&corners);
-                            }
+                            // A face of fewer than 3 corners is skipped and counted.
+                            Role::Face(q) if q == p => fans.push_face(&corners),
                             Role::Grid(q) if q == p => {
                                 if k > 1 {
                                     let msg = format!(
@@ -682,7 +672,10 @@ fn read_body(
         }),
         None => {
             if fans.is_empty() {
-                return Err(IoError::in_file(file, "mesh has no faces"));
+                return Err(IoError::in_file(
+                    file,
+                    format!("mesh has no faces{}", skipped_note(fans.skipped())),
+                ));
             }
             let faces = fans.finish(&positions);
             Ok(PlyBody {

@@ -25,6 +25,10 @@ pub struct TriangleSoup {
     /// plane, a self-intersecting outline, a corner out of range, too many corners) and were
     /// fan-triangulated, at least in part.
     pub n_polygons_unclean: usize,
+    /// How many faces of the input had fewer than 3 corners (OBJ `f 1 2`, an OFF or PLY face
+    /// listing 2 indices, an ASCII STL loop of 2 vertices): they bound no surface, so they were
+    /// skipped rather than refused.
+    pub n_faces_skipped: usize,
 }
 
 /// Why a soup is not valid (see [`TriangleSoup::validate`]).
@@ -61,7 +65,7 @@ impl std::fmt::Display for SoupDefect {
 }
 
 impl TriangleSoup {
-    /// A soup from positions and triangles (`n_polygons` = 0). Nothing is checked; see
+    /// A soup from positions and triangles (all counts 0). Nothing is checked; see
     /// [`TriangleSoup::validate`].
     pub fn new(positions: Vec<DVec3>, triangles: Vec<[u32; 3]>) -> Self {
         Self {
@@ -69,6 +73,7 @@ impl TriangleSoup {
             triangles,
             n_polygons: 0,
             n_polygons_unclean: 0,
+            n_faces_skipped: 0,
         }
     }
 
@@ -94,7 +99,7 @@ impl TriangleSoup {
     ///
     /// Positions are compared exactly (bit for bit), except that `-0.0` and `+0.0` count as the
     /// same coordinate (they are the same point). Returns the welded soup (triangles remapped,
-    /// degenerate triangles kept, `n_polygons` copied) and the map old vertex → new vertex.
+    /// degenerate triangles kept, the counts copied) and the map old vertex → new vertex.
     /// Indices out of range are left as they are (validate first if that matters).
     pub fn welded(&self) -> (TriangleSoup, Vec<u32>) {
         let mut first: HashMap<[u64; 3], u32> = HashMap::with_capacity(self.positions.len());
@@ -127,6 +132,7 @@ impl TriangleSoup {
             triangles,
             n_polygons: self.n_polygons,
             n_polygons_unclean: self.n_polygons_unclean,
+            n_faces_skipped: self.n_faces_skipped,
         };
         (soup, old_to_new)
     }

@@ -5,7 +5,8 @@
 //! name: a file whose size is exactly `84 + 50·n` (with `n` the count at byte 80) is binary, even
 //! if it starts with `solid` (many binary exporters write that); otherwise a file starting with
 //! `solid` is ASCII. ASCII files may hold several `solid … endsolid` blocks; facet normals are
-//! ignored; a loop with more than 3 vertices is fan-triangulated and counted as a polygon.
+//! ignored; a loop with more than 3 vertices is triangulated and counted as a polygon, one with
+//! fewer than 3 is skipped (with its vertices) and counted.
 //!
 //! Binary STL stores f32: writing it rounds f64 coordinates to f32, so it cannot round-trip
 //! arbitrary f64 (f32-representable coordinates do round-trip). The ASCII writer prints f64
@@ -17,7 +18,7 @@ use glam::{DVec3, Vec3};
 
 use crate::error::IoError;
 use crate::soup::TriangleSoup;
-use crate::text::{FanBuilder, lines, parse_point, show, tokens};
+use crate::text::{FanBuilder, lines, parse_point, show, skipped_note, tokens};
 
 /// Size of the binary header plus the triangle count.
 const BINARY_PREAMBLE: usize = 84;
@@ -38,7 +39,8 @@ pub enum StlEncoding {
 ///
 /// Errors: a binary file whose size disagrees with its triangle count (truncated), a file that
 /// is neither binary nor starts with `solid`, malformed ASCII statements (with the line),
-/// NaN/inf coordinates (line, or triangle index for binary), and no triangles.
+/// NaN/inf coordinates (line, or triangle index for binary), and no triangles. An ASCII loop of
+/// fewer than 3 vertices is skipped and counted in [`TriangleSoup::n_faces_skipped`].
 pub fn read_stl(bytes: &[u8], file: &str) -> Result<TriangleSoup, IoError> {
     match detect(bytes) {
         Some(StlEncoding::Binary) => read_binary(bytes, file),
@@ -120,12 +122,7 @@ fn read_binary(bytes: &[u8], file: &str) -> Result<TriangleSoup, IoError> {
         let base = 3 * t as u32;
         triangles.push([base, base + 1, base + 2]);
     }
-    Ok(TriangleSoup {
-        positions,
-        triangles,
-        n_polygons: 0,
-        n_polygons_unclean: 0,
-    })
+    Ok(TriangleSoup::new(positions, triangles))
 }
 
 /// Where the ASCII parser is inside the `solid` grammar.
@@ -185,15 +182,10 @@ fn read_ascii(bytes: &[u8], file: &str) -> Result<TriangleSoup, IoError> {
                 State::Loop
             }
             (State::Loop, b"endloop") => {
+                // A loop of fewer than 3 vertices is skipped and counted by the builder; its
+                // vertices go too, so every vertex still belongs to a facet.
                 if corners.len() < 3 {
-                    return Err(IoError::at_line(
-                        file,
-                        line_no,
-                        format!(
-                            "facet has {} vertices; at least 3 are needed",
-                            corners.len()
-                        ),
-                    ));
+                    positions.truncate(positions.len() - corners.len());
                 }
                 fans.push_face(&corners);
                 State::LoopDone
@@ -210,15 +202,12 @@ fn read_ascii(bytes: &[u8], file: &str) -> Result<TriangleSoup, IoError> {
         ));
     }
     if fans.is_empty() {
-        return Err(IoError::in_file(file, "ASCII STL without facets"));
+        return Err(IoError::in_file(
+            file,
+            format!("ASCII STL without facets{}", skipped_note(fans.skipped())),
+        ));
     }
-    let faces = fans.finish(&positions);
-    Ok(TriangleSoup {
-        positions,
-        triangles: faces.triangles,
-        n_polygons: faces.n_polygons,
-        n_polygons_unclean: faces.n_polygons_unclean,
-    })
+    Ok(fans.finish(&positions).into_soup(positions))
 }
 
 /// Writes `soup` as STL in the given encoding (one record per triangle; the normal is the unit

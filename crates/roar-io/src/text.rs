@@ -81,6 +81,16 @@ pub(crate) fn parse_point<'a>(
     Ok(DVec3::from_array(c))
 }
 
+/// `"; N face(s) with fewer than 3 corners skipped"` when faces were skipped, else `""`: for the
+/// "no faces" errors, so a file of nothing but such faces says why it has none.
+pub(crate) fn skipped_note(skipped: usize) -> String {
+    if skipped == 0 {
+        String::new()
+    } else {
+        format!("; {skipped} face(s) with fewer than 3 corners skipped")
+    }
+}
+
 /// Collects faces and turns them into triangles: triangles as they come, polygons (more than 3
 /// corners) by ear clipping in their own plane once the positions are known
 /// ([`FanBuilder::finish`]; vertices may follow faces in a PLY file).
@@ -90,6 +100,8 @@ pub(crate) struct FanBuilder {
     triangles: Vec<[u32; 3]>,
     /// Each polygon with the length `triangles` had when it came, to keep the file's order.
     polygons: Vec<(usize, Vec<u32>)>,
+    /// Faces with fewer than 3 corners, skipped.
+    skipped: usize,
 }
 
 /// The triangles of every face, in file order, and the polygon counts.
@@ -101,20 +113,43 @@ pub(crate) struct Faces {
     /// Polygons that could not be triangulated cleanly (see
     /// [`crate::polygon::triangulate_polygon`]).
     pub n_polygons_unclean: usize,
+    /// Faces with fewer than 3 corners, skipped.
+    pub n_faces_skipped: usize,
+}
+
+impl Faces {
+    /// The soup of these faces over `positions`.
+    pub fn into_soup(self, positions: Vec<DVec3>) -> crate::soup::TriangleSoup {
+        crate::soup::TriangleSoup {
+            positions,
+            triangles: self.triangles,
+            n_polygons: self.n_polygons,
+            n_polygons_unclean: self.n_polygons_unclean,
+            n_faces_skipped: self.n_faces_skipped,
+        }
+    }
 }
 
 impl FanBuilder {
-    /// Adds a face with `corners.len() >= 3` corners.
+    /// Adds a face. One with fewer than 3 corners (a point or a line segment) bounds no surface:
+    /// it is skipped and counted, since real files have them and they are no reason to refuse
+    /// the rest.
     pub fn push_face(&mut self, corners: &[u32]) {
-        debug_assert!(corners.len() >= 3, "callers reject faces with < 3 corners");
-        if corners.len() > 3 {
+        if corners.len() < 3 {
+            self.skipped += 1;
+        } else if corners.len() > 3 {
             self.polygons.push((self.triangles.len(), corners.to_vec()));
         } else {
             self.triangles.push([corners[0], corners[1], corners[2]]);
         }
     }
 
-    /// Whether no face was added.
+    /// How many faces were skipped so far for having fewer than 3 corners.
+    pub fn skipped(&self) -> usize {
+        self.skipped
+    }
+
+    /// Whether no face with at least 3 corners was added.
     pub fn is_empty(&self) -> bool {
         self.triangles.is_empty() && self.polygons.is_empty()
     }
@@ -127,6 +162,7 @@ impl FanBuilder {
                 triangles: self.triangles,
                 n_polygons,
                 n_polygons_unclean: 0,
+                n_faces_skipped: self.skipped,
             };
         }
         let mut triangles = Vec::with_capacity(self.triangles.len() + 2 * n_polygons);
@@ -144,6 +180,7 @@ impl FanBuilder {
             triangles,
             n_polygons,
             n_polygons_unclean,
+            n_faces_skipped: self.skipped,
         }
     }
 }

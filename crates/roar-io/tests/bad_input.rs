@@ -72,11 +72,11 @@ fn the_small_valid_files_used_below_are_valid() {
 
 #[test]
 fn truncated_files_are_errors() {
-    // OBJ cut inside a face line (an OBJ cut at a line boundary is a smaller valid OBJ).
+    // OBJ cut inside its only face line (an OBJ cut at a line boundary is a smaller valid OBJ).
     assert_error(
         "t.obj",
         &OBJ.as_bytes()[..OBJ.len() - 3],
-        ":4: face has 2 corner(s)",
+        ": no faces found (3 vertices; 1 face(s) with fewer than 3 corners skipped)",
     );
     assert_error(
         "t.off",
@@ -199,26 +199,50 @@ fn indices_out_of_range_are_errors() {
 }
 
 #[test]
-fn faces_with_fewer_than_three_corners_are_errors() {
+fn files_whose_only_faces_have_fewer_than_three_corners_are_errors_that_say_so() {
+    let skipped = "1 face(s) with fewer than 3 corners skipped";
     assert_error(
         "d.obj",
         OBJ.replace("f 1 2 3", "f 1 2").as_bytes(),
-        ":4: face has 2 corner(s)",
+        &format!(": no faces found (3 vertices; {skipped})"),
     );
     assert_error(
         "d.off",
         OFF.replace("3 0 1 2", "2 0 1").as_bytes(),
-        ":6: face has 2 corner(s)",
+        &format!(": mesh has no faces; {skipped}"),
     );
     assert_error(
         "d.ply",
         PLY.replace("3 0 1 2", "2 0 1").as_bytes(),
-        ":13: face 0: face has 2 corner(s)",
+        &format!(": mesh has no faces; {skipped}"),
     );
     assert_error(
         "d.stl",
         STL.replace("vertex 0 1 0\n", "").as_bytes(),
-        ":6: facet has 2 vertices",
+        &format!(": ASCII STL without facets; {skipped}"),
+    );
+}
+
+#[test]
+fn skipped_faces_are_still_checked_for_bad_indices() {
+    assert_error(
+        "d.obj",
+        OBJ.replace("f 1 2 3", "f 1 2 3\nf 1 9").as_bytes(),
+        ":5: face index 9 out of range",
+    );
+    assert_error(
+        "d.off",
+        OFF.replace("3 1 0", "3 2 0")
+            .replace("3 0 1 2", "3 0 1 2\n2 0 7")
+            .as_bytes(),
+        ":7: face index 7 out of range",
+    );
+    assert_error(
+        "d.ply",
+        PLY.replace("element face 1", "element face 2")
+            .replace("3 0 1 2", "3 0 1 2\n2 0 7")
+            .as_bytes(),
+        ":14: face 1: face index 7 out of range",
     );
 }
 

@@ -30,6 +30,8 @@ pub struct Info {
     /// Polygons that could not be triangulated cleanly (no plane, a self-intersecting outline,
     /// too many corners): fan-triangulated, at least in part, so their triangles may overlap.
     pub polygons_unclean: usize,
+    /// Faces of the file with fewer than 3 corners: they bound no surface, so they were skipped.
+    pub faces_skipped: usize,
     /// Distinct vertex positions (bit-identical positions welded).
     pub vertices_welded: usize,
     /// Axis-aligned bounding box of the referenced vertices, `[min, max]`.
@@ -71,6 +73,7 @@ pub fn info(path: &std::path::Path) -> anyhow::Result<Info> {
         faces: soup.triangles.len(),
         polygons: soup.n_polygons,
         polygons_unclean: soup.n_polygons_unclean,
+        faces_skipped: soup.n_faces_skipped,
         vertices_welded: welded.positions.len(),
         bbox,
         closed_manifold: false,
@@ -108,6 +111,12 @@ fn format_text(path: &std::path::Path, info: &Info) -> String {
         text.push_str(&format!(
             "  polygons  {} triangulated, {} not cleanly (no plane or a self-intersecting outline)\n",
             info.polygons, info.polygons_unclean
+        ));
+    }
+    if info.faces_skipped > 0 {
+        text.push_str(&format!(
+            "  skipped   {} face(s) with fewer than 3 corners (no surface)\n",
+            info.faces_skipped
         ));
     }
     match (&info.not_manifold_because, info.genus, info.components) {
