@@ -163,11 +163,20 @@ fn eval_reports_the_documented_json_keys() {
         "chamfer_l2_over_diag",
         "normal_cosine_abs",
         "hausdorff_over_diag",
+        "chamfer_exact",
+        "chamfer_exact_over_diag",
+        "hausdorff_exact_over_diag",
+        "normal_cosine_exact",
+        "normal_cosine_exact_abs",
     ] {
         assert!(fidelity[key].is_number(), "fidelity.{key}");
     }
-    // Against itself, only sampling noise remains.
-    assert!(fidelity["chamfer_l2_over_diag"].as_f64().unwrap() < 0.02);
+    // Against itself, only sampling noise remains in the sampled measure, and nothing in the
+    // exact one.
+    let sampled = fidelity["chamfer_l2_over_diag"].as_f64().unwrap();
+    assert!(sampled > 0.0 && sampled < 0.02, "{sampled}");
+    let exact = fidelity["chamfer_exact_over_diag"].as_f64().unwrap();
+    assert!(exact <= 1e-12, "{exact}");
 }
 
 #[test]

@@ -1,5 +1,7 @@
-//! Times `evaluate` with the default 200k samples per side on a real mesh against itself
-//! (or a procedural sphere pair): `cargo run --release -p roar-eval --example chamfer_timing [FILE.obj]`.
+//! Times `fidelity` and `evaluate` on a real mesh against a copy scaled by 1.01, and splits the
+//! fidelity time into its sampled (k-d tree) and exact (BVH closest point) passes:
+//! `cargo run --release -p roar-eval --example chamfer_timing [FILE.obj [SAMPLES]]` (default: the
+//! armadillo of `$ROAR_TEST_DATA`, `ChamferOptions::default().samples`).
 
 use std::time::Instant;
 
@@ -27,6 +29,10 @@ fn main() {
             + "/clean/armadillo.obj"
     });
     let soup = roar_io::read_mesh(std::path::Path::new(&path)).unwrap_or_else(|e| panic!("{e}"));
+    let samples = std::env::args()
+        .nth(2)
+        .map(|n| n.parse().expect("SAMPLES is a count"))
+        .unwrap_or(ChamferOptions::default().samples);
     let (p, t) = (soup.positions, soup.triangles);
     let shifted: Vec<DVec3> = p.iter().map(|q| *q * 1.01).collect();
     println!(
@@ -35,19 +41,25 @@ fn main() {
         t.len(),
         rayon::current_num_threads()
     );
-    breakdown(&p, &t);
-    let opts = ChamferOptions::default();
+    breakdown(&shifted, &p, &t, samples);
+    let opts = ChamferOptions {
+        samples,
+        ..ChamferOptions::default()
+    };
     for run in 0..3 {
         let start = Instant::now();
         let cpu = cpu_seconds();
         let f = fidelity(&shifted, &t, &p, &t, &opts).unwrap();
         println!(
-            "run {run}: fidelity (2 x {} samples) wall {:.3} s, cpu {:.2} s; chamfer/diag {:.3e}, cos {:.4}",
+            "run {run}: fidelity (2 x {} samples) wall {:.3} s, cpu {:.2} s; chamfer/diag {:.3e} \
+             (exact {:.3e}), cos {:.4} (exact {:.4})",
             opts.samples,
             start.elapsed().as_secs_f64(),
             cpu_seconds() - cpu,
             f.chamfer_l2_over_diag,
-            f.normal_cosine
+            f.chamfer_exact_over_diag,
+            f.normal_cosine,
+            f.normal_cosine_exact
         );
     }
     let start = Instant::now();
@@ -58,7 +70,11 @@ fn main() {
         topo.components
     );
     let start = Instant::now();
-    let report = evaluate(&shifted, &t, Some((&p, &t)), &EvalOptions::default()).unwrap();
+    let eval_options = EvalOptions {
+        chamfer: opts,
+        ..EvalOptions::default()
+    };
+    let report = evaluate(&shifted, &t, Some((&p, &t)), &eval_options).unwrap();
     println!(
         "evaluate (all) {:.3} s; watertight {}",
         start.elapsed().as_secs_f64(),
@@ -66,28 +82,42 @@ fn main() {
     );
 }
 
-/// Stage breakdown of one fidelity call.
-#[allow(dead_code)]
-pub fn breakdown(p: &[DVec3], t: &[[u32; 3]]) {
-    let start = Instant::now();
-    let a = roar_mesh::spatial::sample_surface(p, t, 200_000, 0);
-    let b = roar_mesh::spatial::sample_surface(p, t, 200_000, 1);
-    println!(
-        "  sampling 2 x 200k: {:.3} s",
-        start.elapsed().as_secs_f64()
+/// Stage breakdown of one fidelity call of `shifted` against `p` (same triangles), wall and CPU
+/// seconds: sampling, the sampled passes (two k-d trees, one query per sample), and the whole
+/// call; the exact passes (two BVHs, one closest-point search per sample) are the rest.
+pub fn breakdown(shifted: &[DVec3], p: &[DVec3], t: &[[u32; 3]], samples: usize) {
+    let clock = || (Instant::now(), cpu_seconds());
+    let since = |(wall, cpu): (Instant, f64)| (wall.elapsed().as_secs_f64(), cpu_seconds() - cpu);
+    let start = clock();
+    let (a, b) = rayon::join(
+        || roar_mesh::spatial::sample_surface(shifted, t, samples, 0),
+        || roar_mesh::spatial::sample_surface(p, t, samples, 1),
     );
-    let start = Instant::now();
-    let n = roar_eval::nearest_neighbours(&a.points, &b.points);
-    println!(
-        "  one tree + 200k queries: {:.3} s ({})",
-        start.elapsed().as_secs_f64(),
-        n.len()
+    let sampling = since(start);
+    let start = clock();
+    let (ab, ba) = rayon::join(
+        || roar_eval::nearest_neighbours(&b.points, &a.points),
+        || roar_eval::nearest_neighbours(&a.points, &b.points),
     );
-    let start = Instant::now();
-    let n = roar_eval::nearest_neighbours(&a.points, &b.points[..1]);
+    let sampled = since(start);
+    assert_eq!(ab.len() + ba.len(), 2 * samples);
+    let options = ChamferOptions {
+        samples,
+        ..ChamferOptions::default()
+    };
+    let start = clock();
+    fidelity(shifted, t, p, t, &options).expect("the mesh has area");
+    let whole = since(start);
     println!(
-        "  one tree + 1 query: {:.3} s ({})",
-        start.elapsed().as_secs_f64(),
-        n.len()
+        "  2 x {samples} samples, wall / cpu s: sampling {:.3} / {:.2}, sampled passes {:.3} / {:.2}, \
+         whole fidelity {:.3} / {:.2}, so exact passes ≈ {:.3} / {:.2}",
+        sampling.0,
+        sampling.1,
+        sampled.0,
+        sampled.1,
+        whole.0,
+        whole.1,
+        whole.0 - sampling.0 - sampled.0,
+        whole.1 - sampling.1 - sampled.1
     );
 }

@@ -8,8 +8,9 @@
 //!   duplicate positions first.
 //! - [`triangle_quality`]: aspect ratio `Q = R/(2r)` statistics.
 //! - [`fidelity`]: Chamfer L2 (mean and PyTorch3D squared-sum forms), Hausdorff and normal cosine
-//!   similarity against a reference, from area-weighted samples (`roar_mesh::spatial::sample_surface`)
-//!   and k-d tree nearest neighbours.
+//!   similarity against a reference, from area-weighted samples (`roar_mesh::spatial::sample_surface`),
+//!   each both to the other side's nearest sample (k-d tree) and to the other mesh's exact closest
+//!   point (BVH).
 //! - [`self_intersections`]: faces intersecting a non-adjacent face (exact, on the welded mesh),
 //!   and the paper's ε-offset variant.
 //! - [`evaluate`] gathers everything in a serde [`Report`].

@@ -111,6 +111,11 @@ fn report_serializes_its_sections() {
         "normal_cosine_abs",
         "hausdorff",
         "hausdorff_over_diag",
+        "chamfer_exact",
+        "chamfer_exact_over_diag",
+        "hausdorff_exact_over_diag",
+        "normal_cosine_exact",
+        "normal_cosine_exact_abs",
     ] {
         assert!(json["fidelity"][key].is_number(), "missing fidelity.{key}");
     }

@@ -1,5 +1,5 @@
-//! `roar eval MESH [--ref REF] [--json]`: every metric of spec §6.1 for a mesh, and its fidelity
-//! to a reference.
+//! `roar eval MESH [--ref REF] [--json]`: topology, quality, orientation and self-intersections of
+//! a mesh, and its fidelity to a reference (sampled and exact Chamfer, Hausdorff, normal cosine).
 
 use std::path::PathBuf;
 
@@ -17,10 +17,11 @@ pub struct EvalArgs {
     /// Print the JSON report instead of text.
     #[arg(long)]
     pub json: bool,
-    /// Area-weighted samples per side for the fidelity metrics (at least 1 with `--ref`).
+    /// Area-weighted samples per side for the fidelity metrics, sampled and exact (at least 1 with
+    /// `--ref`).
     #[arg(long, default_value_t = ChamferOptions::default().samples)]
     pub samples: usize,
-    /// Seed of the sampling.
+    /// Seed of the sampling (the reference's samples use seed + 1).
     #[arg(long, default_value_t = ChamferOptions::default().seed)]
     pub seed: u64,
 }
@@ -129,6 +130,15 @@ pub fn format_text(report: &Report) -> String {
             f.hausdorff_over_diag,
             f.normal_cosine,
             f.normal_cosine_abs
+        ));
+        text.push_str(&format!(
+            "exact chamfer {:.6e} ({:.6e} of the reference diagonal), hausdorff/diag {:.6e}\n\
+             exact normal cosine {:.4} (absolute {:.4})\n",
+            f.chamfer_exact,
+            f.chamfer_exact_over_diag,
+            f.hausdorff_exact_over_diag,
+            f.normal_cosine_exact,
+            f.normal_cosine_exact_abs
         ));
     }
     text

@@ -13,7 +13,8 @@
 //! [`tri_tri`] (exact triangle–triangle tests), [`filtered_tri_tri`] (the same behind certified
 //! floating-point filters, for many pairs), [`self_intersections`], [`sampling`]
 //! (area-weighted random samples),
-//! [`winding`] (fast winding numbers), [`regular_sampling`] (regular per-face grids),
+//! [`winding`] (fast winding numbers, and the Morton order batched queries visit points in),
+//! [`regular_sampling`] (regular per-face grids),
 //! [`projector`] (the `Projector` trait), [`ray_projector`] (exact ray-cast projection, §3.4 (B)),
 //! [`triangle`] (one triangle's normal, angles and aspect ratio),
 //! [`vertex_normals`](mod@vertex_normals) (vertex normals by named weightings, §2.2), [`sdf`] (the `Sdf` trait
@@ -62,6 +63,6 @@ pub use tri_tri::{faces_intersect, segment_intersects_triangle, triangles_inters
 pub use triangle::{corner_angles, triangle_normal, triangle_quality};
 pub use vertex_normals::{area_angle_weights, area_weighted_vertex_normals, vertex_normals};
 pub use winding::{
-    TriangleIndexError, WindingNumber, WindingNumberOptions, exact_winding_number,
+    TriangleIndexError, WindingNumber, WindingNumberOptions, exact_winding_number, morton_order,
     triangle_solid_angle,
 };

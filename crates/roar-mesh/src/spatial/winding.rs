@@ -283,8 +283,9 @@ impl WindingNumber {
 }
 
 /// Indices of `points` sorted by the Morton code of their position in the points' bounding box
-/// (non-finite points first); a stable sort, so the order is deterministic.
-fn morton_order(points: &[DVec3]) -> Vec<u32> {
+/// (non-finite points first); a stable sort, so the order is deterministic. Batched tree queries
+/// visit points in this order so that consecutive queries walk the same part of the tree.
+pub fn morton_order(points: &[DVec3]) -> Vec<u32> {
     let mut lo = DVec3::splat(f64::INFINITY);
     let mut hi = DVec3::splat(f64::NEG_INFINITY);
     for p in points.iter().filter(|p| p.is_finite()) {
