@@ -1,5 +1,6 @@
 //! `roar batch` and `roar batch-report` end to end on tiny items: bad manifests are refused up
-//! front, failures are recorded and the batch goes on, a rerun skips what is done.
+//! front, failures are recorded and the batch goes on, a rerun skips what is done, and manifest
+//! labels reach the records and the report's breakdown.
 
 use std::path::Path;
 use std::process::{Command, Output};
@@ -91,7 +92,8 @@ fn a_batch_records_failures_goes_on_and_resumes() {
     std::fs::write(d.join("tiny.toml"), TINY).unwrap();
     std::fs::write(
         d.join("manifest.csv"),
-        "id,path,faces\nchair,chair.obj,\nbroken,bad.obj,\nodd,chair.obj,201\n",
+        "id,path,faces,family\nchair,chair.obj,,furniture\nbroken,bad.obj,,junk\n\
+         odd,chair.obj,201,furniture\n",
     )
     .unwrap();
     let args = [
@@ -141,6 +143,7 @@ fn a_batch_records_failures_goes_on_and_resumes() {
     let record: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(out.join("chair/200.json")).unwrap())
             .unwrap();
+    assert_eq!(record["labels"]["family"], "furniture");
     for key in ["input_hash", "config_hash", "build"] {
         assert_eq!(record[key].as_str().unwrap().len(), 16, "{key}");
     }
@@ -182,7 +185,7 @@ fn a_batch_records_failures_goes_on_and_resumes() {
         stderr(&third)
     );
 
-    let report = roar(d, &["batch-report", "out"]);
+    let report = roar(d, &["batch-report", "out", "--by", "family"]);
     assert!(report.status.success(), "{}", stderr(&report));
     let md = String::from_utf8_lossy(&report.stdout);
     assert!(
@@ -196,5 +199,30 @@ fn a_batch_records_failures_goes_on_and_resumes() {
     assert_eq!(json["budgets"][0]["budget"], 200);
     assert_eq!(json["budgets"][0]["genus"]["median"], 0.0);
     assert_eq!(json["worst"][0]["id"], "chair");
+    assert_eq!(json["slowest"][0]["id"], "chair");
+    assert_eq!(json["slowest"][0]["label"], "furniture");
+    let groups: Vec<(&str, u64, u64, u64)> = json["by_label"]["groups"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|g| {
+            let count = |k: &str| g[k].as_u64().unwrap();
+            (
+                g["value"].as_str().unwrap(),
+                g["budget"].as_u64().unwrap(),
+                count("done"),
+                count("failed"),
+            )
+        })
+        .collect();
+    assert_eq!(
+        groups,
+        [
+            ("furniture", 200, 1, 0),
+            ("furniture", 201, 0, 1),
+            ("junk", 200, 0, 1)
+        ]
+    );
+    assert!(md.contains("## By family"), "{md}");
     assert_eq!(std::fs::read_to_string(out.join("report.md")).unwrap(), md);
 }

@@ -12,6 +12,7 @@
 //! failures of a run are appended, one JSON line each, to `OUTDIR/failures.jsonl` (or
 //! `failures-I-of-K.jsonl` for shard I of K, so concurrent shards never write one file).
 
+use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
@@ -36,6 +37,10 @@ pub struct PlanItem {
     pub input: String,
     /// Its budgets.
     pub budgets: Vec<usize>,
+    /// Its manifest labels, which `roar batch-report --by` groups done, failed and missing
+    /// items by (absent in plans of batches before labels).
+    #[serde(default)]
+    pub labels: BTreeMap<String, String>,
 }
 
 /// What `OUTDIR/<id>/<budget>.json` holds: the fingerprints that decide a resume, and the
@@ -56,6 +61,10 @@ pub struct ItemRecord {
     pub build: String,
     /// Wall-clock seconds of the child process.
     pub seconds: f64,
+    /// The item's manifest labels when it ran, so the record describes its item on its own
+    /// (absent in records of batches before labels).
+    #[serde(default)]
+    pub labels: BTreeMap<String, String>,
     /// The `roar reconstruct` JSON report.
     pub reconstruct: serde_json::Value,
 }
@@ -201,6 +210,7 @@ mod tests {
             config_hash: "c".into(),
             build: build.into(),
             seconds: 1.0,
+            labels: BTreeMap::new(),
             reconstruct: serde_json::Value::Null,
         };
         std::fs::write(&files.record, serde_json::to_string(&r).unwrap()).unwrap();

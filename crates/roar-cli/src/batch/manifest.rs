@@ -1,13 +1,15 @@
 //! The list of a batch's items: one input path a line, or a CSV/TSV table with a header naming
-//! an `id` and a `path` column and optional per-item overrides.
+//! an `id` and a `path` column, optional per-item overrides and any other columns as labels.
 //!
 //! Blank lines and lines starting with `#` are ignored. Relative paths are relative to the
 //! manifest's folder. A table's header must name `path`; it may also name `id`, `faces` (one
 //! budget or several separated by `;` or spaces), `iterations`, `seed` and `timeout` (seconds).
+//! Every other column is a label: its non-empty fields are kept as the item's labels, which the
+//! batch records and `roar batch-report --by NAME` groups by. Column names are lowercased.
 //! Fields are trimmed and may be wrapped in double quotes, but cannot contain the delimiter
 //! (use TSV for paths with commas). Every error names the manifest's line.
 
-use std::collections::HashMap;
+use std::collections::{BTreeMap, HashMap};
 use std::path::{Component, Path, PathBuf};
 
 use anyhow::{Context, bail};
@@ -27,6 +29,8 @@ pub struct Item {
     pub seed: Option<u64>,
     /// Timeout of this item in seconds, replacing the batch's `--timeout`.
     pub timeout: Option<f64>,
+    /// The item's non-empty fields of the manifest's other columns, by column name.
+    pub labels: BTreeMap<String, String>,
     /// 1-based line of the manifest the item comes from.
     pub line: usize,
 }
@@ -40,7 +44,7 @@ pub fn read_manifest(path: &Path) -> anyhow::Result<Vec<Item>> {
 }
 
 /// Parses a manifest's text; relative paths are joined to `base`. Refuses an empty manifest,
-/// an unknown column, an unparsable override, an unsafe id and two items with one id.
+/// an unnamed or repeated column, an unparsable override, an unsafe id and two items with one id.
 pub fn parse_manifest(text: &str, base: &Path) -> anyhow::Result<Vec<Item>> {
     let lines: Vec<(usize, &str)> = text
         .lines()
@@ -48,7 +52,7 @@ pub fn parse_manifest(text: &str, base: &Path) -> anyhow::Result<Vec<Item>> {
         .map(|(i, l)| (i + 1, l.trim()))
         .filter(|(_, l)| !l.is_empty() && !l.starts_with('#'))
         .collect();
-    let Some(&(_, first)) = lines.first() else {
+    let Some(&(first_line, first)) = lines.first() else {
         bail!("no items");
     };
     let delimiter = if first.contains('\t') { '\t' } else { ',' };
@@ -57,6 +61,7 @@ pub fn parse_manifest(text: &str, base: &Path) -> anyhow::Result<Vec<Item>> {
         .map(|f| f.to_ascii_lowercase())
         .collect();
     let items = if header.iter().any(|f| f == "path") {
+        check_header(&header, first_line)?;
         parse_table(&header, &lines[1..], delimiter, base)?
     } else {
         lines
@@ -70,6 +75,7 @@ pub fn parse_manifest(text: &str, base: &Path) -> anyhow::Result<Vec<Item>> {
                     iterations: None,
                     seed: None,
                     timeout: None,
+                    labels: BTreeMap::new(),
                     line,
                 })
             })
@@ -91,7 +97,22 @@ pub fn parse_manifest(text: &str, base: &Path) -> anyhow::Result<Vec<Item>> {
     Ok(items)
 }
 
+/// The columns a batch reads itself; every other column is a label.
 const COLUMNS: [&str; 6] = ["id", "path", "faces", "iterations", "seed", "timeout"];
+
+/// Refuses a header with an empty column name or one name twice, which would make a field's
+/// meaning ambiguous.
+fn check_header(header: &[String], line: usize) -> anyhow::Result<()> {
+    for (i, name) in header.iter().enumerate() {
+        if name.is_empty() {
+            bail!("line {line}: column {} has no name", i + 1);
+        }
+        if header[..i].contains(name) {
+            bail!("line {line}: column {name:?} appears twice");
+        }
+    }
+    Ok(())
+}
 
 fn parse_table(
     header: &[String],
@@ -99,11 +120,6 @@ fn parse_table(
     delimiter: char,
     base: &Path,
 ) -> anyhow::Result<Vec<Item>> {
-    for name in header {
-        if !COLUMNS.contains(&name.as_str()) {
-            bail!("unknown column {name:?} (known: {})", COLUMNS.join(", "));
-        }
-    }
     let column = |name: &str| header.iter().position(|h| h == name);
     let (id_col, path_col) = (column("id"), column("path").expect("checked"));
     let mut items = Vec::with_capacity(rows.len());
@@ -145,6 +161,12 @@ fn parse_table(
             .map(|f| parse_seconds(f).map_err(anyhow::Error::msg))
             .transpose()
             .map_err(at)?;
+        let labels = header
+            .iter()
+            .zip(&fields)
+            .filter(|(name, field)| !COLUMNS.contains(&name.as_str()) && !field.is_empty())
+            .map(|(name, field)| (name.clone(), field.to_string()))
+            .collect();
         items.push(Item {
             id,
             input: base.join(path),
@@ -152,6 +174,7 @@ fn parse_table(
             iterations,
             seed,
             timeout,
+            labels,
             line,
         });
     }
@@ -276,11 +299,62 @@ mod tests {
         assert!(err("a_b.obj\na/b.obj\n").contains("lines 1 and 2 have the same id"));
         assert!(err("id,path\nq,a.obj\nq,b.obj\n").contains("same id \"q\""));
         assert!(err("id,path\n../up,a.obj\n").contains("line 2"));
-        assert!(err("path,colour\na,red\n").contains("unknown column"));
+        assert!(
+            err("path,colour,colour\na,red,blue\n")
+                .contains("line 1: column \"colour\" appears twice")
+        );
+        assert!(err("# header\npath,,faces\na,red,1\n").contains("line 2: column 2 has no name"));
         assert!(err("path,faces\na,ten\n").contains("line 2"));
         assert!(err("path,faces\na,0\n").contains("positive"));
         assert!(err("path,faces\na\n").contains("1 fields"));
         assert!(err("path,timeout\na,-1\n").contains("seconds"));
+    }
+
+    /// The header of the shared corpus manifest.
+    const CORPUS_HEADER: &str = "id\tpath\tfamily\tinput_faces\tsource\tvertices\tbytes\t\
+        watertight\twinding_consistent\tbodies\tcharacter\tconversion\tsha256";
+
+    #[test]
+    fn extra_columns_are_labels_and_input_faces_is_not_a_budget() {
+        let text = format!(
+            "{CORPUS_HEADER}\n\
+             lh_link18\tmeshes/cad/lh_link18.stl\tcad\t3652\tpypi:robosuite\t10956\t182684\t\
+             1\t1\t1\tCAD\tverbatim\t9425aea7\n\
+             bunny\tmeshes/scan/bunny.ply\tscan\t69451\t\t35947\t3033120\t0\t1\t5\tscan\t\
+             ply\t2980b03a\n"
+        );
+        let items = parse_manifest(&text, Path::new("/corpus")).unwrap();
+        assert_eq!(items.len(), 2);
+        let cad = &items[0];
+        assert_eq!(cad.id, "lh_link18");
+        assert_eq!(cad.input, PathBuf::from("/corpus/meshes/cad/lh_link18.stl"));
+        assert_eq!(cad.faces, None);
+        assert_eq!(cad.labels.len(), 11);
+        assert_eq!(cad.labels["family"], "cad");
+        assert_eq!(cad.labels["input_faces"], "3652");
+        assert_eq!(cad.labels["sha256"], "9425aea7");
+        assert!(!cad.labels.contains_key("path") && !cad.labels.contains_key("id"));
+        // An empty field is no label.
+        assert_eq!(items[1].labels.get("source"), None);
+        assert_eq!(items[1].labels["family"], "scan");
+    }
+
+    /// The shared corpus manifest, when `ROAR_TEST_DATA` points at the shared meshes beside it.
+    #[test]
+    fn the_shared_corpus_manifest_loads_with_its_families() {
+        let Some(meshes) = std::env::var_os("ROAR_TEST_DATA") else {
+            eprintln!("note: ROAR_TEST_DATA unset; skipping the corpus manifest");
+            return;
+        };
+        let path = Path::new(&meshes).join("../corpus/manifest.tsv");
+        if !path.is_file() {
+            eprintln!("note: no {}; skipping the corpus manifest", path.display());
+            return;
+        }
+        let items = read_manifest(&path).unwrap();
+        assert_eq!(items.len(), 250);
+        assert!(items.iter().all(|i| i.labels.contains_key("family")));
+        assert!(items.iter().all(|i| i.faces.is_none()));
     }
 
     #[test]

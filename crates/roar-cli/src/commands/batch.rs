@@ -30,7 +30,7 @@ use crate::commands::reconstruct::{ReconstructArgs, effective_config};
 #[derive(Args, Debug)]
 pub struct BatchArgs {
     /// The manifest: one input path a line, or CSV/TSV with a header naming `path` and
-    /// optionally `id`, `faces`, `iterations`, `seed`, `timeout`.
+    /// optionally `id`, `faces`, `iterations`, `seed`, `timeout`; other columns are labels.
     pub manifest: PathBuf,
     /// Output folder: `OUTDIR/<id>/<budget>.<format>` and `<budget>.json` per item.
     #[arg(short, long)]
@@ -365,6 +365,7 @@ fn finish(
         config_hash,
         build: build.to_string(),
         seconds,
+        labels: task.item.labels.clone(),
         reconstruct,
     };
     let json = serde_json::to_string_pretty(&record)?;
@@ -389,6 +390,7 @@ fn write_plan(
                 id: item.id.clone(),
                 input: item.input.display().to_string(),
                 budgets: item.faces.clone().unwrap_or_else(|| budgets.to_vec()),
+                labels: item.labels.clone(),
             })
             .collect(),
     };
@@ -521,6 +523,7 @@ mod tests {
                 iterations: None,
                 seed: None,
                 timeout: None,
+                labels: Default::default(),
                 line: 2,
             };
             effective_config(&reconstruct_args(&cli.args, Some(&item), Some(200))).unwrap()
