@@ -2,6 +2,7 @@
 
 use roar_loss::LossError;
 use roar_ops::decimate::DecimateError;
+use roar_ops::finish::exact_budget::ExactBudgetError;
 use roar_ops::finish::genus::ReduceGenusError;
 use roar_ops::init::InitError;
 
@@ -37,4 +38,15 @@ pub enum PipelineError {
     /// The budget is below a tetrahedron per piece, or a handle could not be cut.
     #[error("{0}")]
     Genus(#[from] ReduceGenusError),
+}
+
+impl From<ExactBudgetError> for PipelineError {
+    fn from(error: ExactBudgetError) -> Self {
+        match error {
+            ExactBudgetError::Decimate(error) => PipelineError::Budget(error),
+            ExactBudgetError::Genus(error) => PipelineError::Genus(error),
+            ExactBudgetError::Intersections(faces) => PipelineError::Intersections(faces),
+            ExactBudgetError::Missed { .. } => PipelineError::Internal(error.to_string()),
+        }
+    }
 }

@@ -58,9 +58,7 @@ pub use config::{
 pub use error::PipelineError;
 pub use objective::{LossFactory, Prepared, default_loss, planar_options};
 pub use reconstruction::{Output, Reconstruction};
-pub use report::{
-    FinishStats, InitStats, IterationRecord, OptimizeStats, RunStats, TargetStats, UntangleFailure,
-};
+pub use report::{FinishStats, InitStats, IterationRecord, OptimizeStats, RunStats, TargetStats};
 pub use rig::{coarse_rig_cameras, rig_cameras, target_options};
 pub use run::Progress;
 pub use schedule::{ScheduledBlock, default_blocks};

@@ -2,6 +2,7 @@
 
 use std::collections::BTreeMap;
 
+use roar_ops::finish::best_state::UntangleFailure;
 use roar_ops::finish::genus::RemovedHandle;
 use serde::Serialize;
 
@@ -140,13 +141,4 @@ pub struct IterationRecord {
     pub terms: BTreeMap<&'static str, f64>,
     /// Faces when the loss was evaluated.
     pub faces: usize,
-}
-
-/// A loop state the untangle block could not clear.
-#[derive(Debug, Clone, Default, Serialize)]
-pub struct UntangleFailure {
-    /// The iteration whose starting state it was (`iterations` for the last state).
-    pub iteration: usize,
-    /// Faces still intersecting.
-    pub unresolved_faces: usize,
 }

@@ -1,14 +1,16 @@
 //! `roar decimate INPUT -o OUTPUT --faces N [--best-effort] [--reduce-genus]`: the guaranteed
 //! QEM. The input must be a closed 2-manifold; the output keeps its genus and components, has
 //! exactly N faces and no new self-intersections, or the command fails saying how close it got.
-//! With `--reduce-genus` handles are removed (shortest loop first, `roar_ops::finish::genus`) when the
-//! genus needs more faces than N or the QEM stalls; components are still kept.
+//! With `--reduce-genus` handles are removed as the reconstruction's finish removes them
+//! (`roar_ops::finish::exact_budget`: shortest loop first, the crossings of each cut untangled)
+//! when the genus needs more faces than N or the QEM stalls; components are still kept.
 
 use std::path::PathBuf;
 
 use clap::Args;
 use roar_ops::decimate::{DecimateOptions, decimate_in_parallel};
-use roar_ops::finish::genus::{HandleRemovalOptions, decimate_removing_handles};
+use roar_ops::finish::exact_budget::{ExactBudgetOptions, decimate_to_exact_budget};
+use roar_ops::untangle::UntangleOptions;
 
 use crate::checks::check_paths;
 use crate::mesh_files::{parse_faces, read_closed_mesh, write_mesh};
@@ -55,28 +57,22 @@ pub fn run(args: &DecimateArgs) -> anyhow::Result<()> {
             args.input.display()
         );
     }
-    let options = DecimateOptions {
-        best_effort: args.best_effort,
-        ..DecimateOptions::default()
+    let options = ExactBudgetOptions {
+        decimate: DecimateOptions {
+            best_effort: args.best_effort,
+            ..DecimateOptions::default()
+        },
+        keep_topology: !args.reduce_genus,
+        untangle: UntangleOptions::default(),
     };
-    let stats = if args.reduce_genus {
-        let (stats, removed) = decimate_removing_handles(
-            &mut mesh,
-            args.faces,
-            &options,
-            &HandleRemovalOptions::default(),
-            decimate_in_parallel,
-        )?;
-        for handle in &removed {
-            eprintln!(
-                "note: removed a handle (cut along a loop of {} edges, length {:.4})",
-                handle.loop_vertices, handle.loop_length
-            );
-        }
-        stats
-    } else {
-        decimate_in_parallel(&mut mesh, args.faces, &options)?
-    };
+    let reached = decimate_to_exact_budget(&mut mesh, args.faces, &options, decimate_in_parallel)?;
+    for handle in &reached.handles_removed {
+        eprintln!(
+            "note: removed a handle (cut along a loop of {} edges, length {:.4})",
+            handle.loop_vertices, handle.loop_length
+        );
+    }
+    let stats = reached.decimate;
     let reached = mesh.n_faces() == args.faces;
     write_mesh(&args.output, &mesh)?;
     if reached {

@@ -13,19 +13,22 @@ use roar_mesh::Mesh;
 use roar_mesh::spatial::{Normalization, Sdf, self_intersecting_faces};
 use roar_ops::blocks::smoothing::SmoothingOptions;
 use roar_ops::decimate::{DecimateOptions, DecimateStats, decimate};
+use roar_ops::finish::best_state::{
+    BestStateOptions, Candidate, finish_from_best_state as finish_from_best_state_of,
+};
 use roar_ops::finish::data_flips::{DataFlipOptions, flip_toward_target};
 use roar_ops::finish::degenerate::{DegenerateOptions, collapse_degenerate_faces};
-use roar_ops::finish::fill::{fill_to_budget, fill_to_budget_on_field};
+use roar_ops::finish::exact_budget::{ExactBudgetOptions, decimate_to_exact_budget};
+use roar_ops::finish::fill::fill_to_budget;
 use roar_ops::finish::fins::{FinOptions, collapse_fins};
-use roar_ops::finish::genus::{HandleRemovalOptions, decimate_removing_handles, remove_handles};
 use roar_ops::finish::offset::offset_outward;
 use roar_ops::finish::slivers::{SliverOptions, flip_slivers};
 use roar_ops::finish::zero_set::{ZeroSetOptions, ZeroSetStats, fit_to_zero_set};
-use roar_ops::untangle::{UntangleOptions, UntangleStats, untangle};
+use roar_ops::untangle::UntangleOptions;
 
 use crate::config::ReconstructConfig;
 use crate::error::PipelineError;
-use crate::report::{RunStats, UntangleFailure};
+use crate::report::RunStats;
 use crate::run::{Run, StageClock};
 use crate::stages::optimize::{LoopState, move_vertices, new_optimizer};
 
@@ -113,58 +116,42 @@ pub(crate) fn finish(
     Ok(mesh)
 }
 
-/// Fills and untangles the loop's states in order of increasing loss (the later one first
-/// among equals) and returns the first one the untangle block clears, recording the others in
-/// `stats.untangle_failures`. Fails with the last state's unresolved face count when none
-/// clears.
+/// The lowest-loss loop state that fills to N and untangles
+/// ([`roar_ops::finish::best_state`]), with its figures recorded in `stats`.
 fn finish_from_best_state(
-    mut states: Vec<LoopState>,
+    states: Vec<LoopState>,
     field: Option<&dyn Sdf>,
     config: &ReconstructConfig,
     stats: &mut RunStats,
 ) -> Result<Mesh, PipelineError> {
-    states.sort_by(|a, b| {
-        a.loss
-            .total_cmp(&b.loss)
-            .then(b.iteration.cmp(&a.iteration))
-    });
-    let mut unresolved = 0;
-    for state in states {
-        let mut mesh = state.mesh;
-        unresolved = fill_and_untangle(&mut mesh, field, config, stats);
-        if unresolved == 0 {
-            stats.optimize.finished_from_iteration = state.iteration;
-            return Ok(mesh);
-        }
-        stats.optimize.untangle_failures.push(UntangleFailure {
+    let candidates = states
+        .into_iter()
+        .map(|state| Candidate {
+            mesh: state.mesh,
+            loss: state.loss,
             iteration: state.iteration,
-            unresolved_faces: unresolved,
-        });
-    }
-    Err(PipelineError::Intersections(unresolved))
-}
-
-/// Fills the mesh up to `config.faces` (on a field, where the chords stray farthest from its zero
-/// set first, the new vertices on it: `fill_to_budget_on_field`), runs the untangle block and
-/// fills again, longest edge first (its collapses may take the mesh below the budget, and the
-/// final QEM never adds faces; those splits move no geometry, so no intersection comes back).
-/// Returns how many faces it could not clear.
-fn fill_and_untangle(
-    mesh: &mut Mesh,
-    field: Option<&dyn Sdf>,
-    config: &ReconstructConfig,
-    stats: &mut RunStats,
-) -> usize {
-    stats.finish.fill_splits = match field {
-        Some(field) => {
-            fill_to_budget_on_field(mesh, config.faces, field, config.loss.sdf_loss_epsilon)
-        }
-        None => fill_to_budget(mesh, config.faces),
+        })
+        .collect();
+    let options = BestStateOptions {
+        faces: config.faces,
+        untangle: untangle_options(config),
+        field_epsilon: config.loss.sdf_loss_epsilon,
     };
-    let untangled = untangle(mesh, &untangle_options(config));
-    record_untangle(stats, &untangled);
-    stats.finish.fill_splits += fill_to_budget(mesh, config.faces);
-    untangled.unresolved_faces.len()
+    let (result, best) = match finish_from_best_state_of(candidates, field, &options) {
+        Ok((mesh, best)) => (Ok(mesh), best),
+        Err(best) => (
+            Err(PipelineError::Intersections(best.fill.unresolved_faces)),
+            best,
+        ),
+    };
+    stats.finish.fill_splits = best.fill.fill_splits;
+    stats.finish.untangle_initial_pairs = best.fill.untangle_initial_pairs;
+    stats.finish.untangle_rounds = best.fill.untangle_rounds;
+    stats.optimize.untangle_failures = best.failures;
+    if result.is_ok() {
+        stats.optimize.finished_from_iteration = best.iteration;
+    }
+    result
 }
 
 /// The untangle block's options under `config` (its separation margin).
@@ -173,11 +160,6 @@ fn untangle_options(config: &ReconstructConfig) -> UntangleOptions {
         margin_rel: config.finish.untangle_margin,
         ..UntangleOptions::default()
     }
-}
-
-fn record_untangle(stats: &mut RunStats, untangled: &UntangleStats) {
-    stats.finish.untangle_initial_pairs = untangled.initial_pairs;
-    stats.finish.untangle_rounds = untangled.rounds;
 }
 
 /// The face counts the finish decimates to, each followed by a polish: `[2N, N]` when the
@@ -198,105 +180,26 @@ fn finish_budgets(faces: usize, budget: usize, polishing: bool) -> Vec<usize> {
     }
 }
 
-/// The guaranteed QEM to exactly `faces` (best effort only if configured). Unless
-/// `keep_topology`, handles are removed (shortest loop first, `roar_ops::finish::genus`) when
-/// the genus needs more faces than `faces` or the QEM stalls above it, the crossings of each
-/// cut untangled at once and again at the end; when some stay, the whole step is retried with
-/// more handles removed first. Each removal is noted on stderr and recorded in
-/// `stats.handles_removed`.
+/// The guaranteed QEM to exactly `faces` (best effort only if configured), removing handles
+/// unless `keep_topology` ([`roar_ops::finish::exact_budget`]); the handles removed are recorded
+/// in `stats.handles_removed`.
 fn final_decimation(
     mesh: &mut Mesh,
     faces: usize,
     config: &ReconstructConfig,
     stats: &mut RunStats,
 ) -> Result<DecimateStats, PipelineError> {
-    let options = DecimateOptions {
-        best_effort: config.finish.best_effort,
-        ..DecimateOptions::default()
+    let options = ExactBudgetOptions {
+        decimate: DecimateOptions {
+            best_effort: config.finish.best_effort,
+            ..DecimateOptions::default()
+        },
+        keep_topology: config.finish.keep_topology,
+        untangle: untangle_options(config),
     };
-    let decimated = if config.finish.keep_topology {
-        decimate(mesh, faces, &options)?
-    } else {
-        // A cut whose caps cross the surface is untangled at once, but at a small budget the
-        // untangle may lack the faces to clear it (a random soup at 500 faces, 45 handles).
-        // Each retry starts again from the mesh as it came and makes first, on that larger
-        // mesh, as many cuts as the failed attempt made in all (at least one more than the
-        // previous retry), so that the caps are untangled while there is room.
-        let original = mesh.clone();
-        let genus = original.genus();
-        let handles = HandleRemovalOptions {
-            untangle: Some(untangle_options(config)),
-            ..HandleRemovalOptions::default()
-        };
-        let mut removed_first = Vec::new();
-        loop {
-            let (decimated, needed) =
-                decimate_removing_handles(mesh, faces, &options, &handles, decimate)?;
-            let mut removed = removed_first.clone();
-            removed.extend(needed);
-            let untangled = if removed.is_empty() {
-                Ok(())
-            } else {
-                untangle_cut_caps(mesh, faces, config)
-            };
-            match untangled {
-                Ok(()) => {
-                    for handle in &removed {
-                        eprintln!(
-                            "note: removed a handle to reach {faces} faces (cut along a loop of \
-                             {} edges, length {:.4} in the unit sphere; --keep-topology fails \
-                             instead)",
-                            handle.loop_vertices, handle.loop_length
-                        );
-                    }
-                    stats.finish.handles_removed.extend(removed);
-                    break decimated;
-                }
-                Err(PipelineError::Intersections(n)) if removed_first.len() < genus => {
-                    let more = removed.len().max(removed_first.len() + 1);
-                    eprintln!(
-                        "note: {n} faces still crossed after removing {} handles; trying again \
-                         with {more} removed first",
-                        removed.len()
-                    );
-                    *mesh = original.clone();
-                    let first = remove_handles(mesh, more, &handles);
-                    // No progress (no handle could be cut): the crossings stay, and so does
-                    // the error.
-                    match first {
-                        Ok(first) if first.len() > removed_first.len() => removed_first = first,
-                        _ => return Err(PipelineError::Intersections(n)),
-                    }
-                }
-                Err(error) => return Err(error),
-            }
-        }
-    };
-    if mesh.n_faces() != faces && !config.finish.best_effort {
-        return Err(PipelineError::Internal(format!(
-            "the output has {} faces instead of {}",
-            mesh.n_faces(),
-            faces
-        )));
-    }
-    Ok(decimated)
-}
-
-/// Clears the crossings the caps of removed handles may make with the surface near them (a cap
-/// spans its loop's rim, whatever lies across it), then fills back to `faces`; fails with the
-/// count of faces still crossing, so no output with a self-intersection is written. A mesh
-/// without crossings is left as it is.
-fn untangle_cut_caps(
-    mesh: &mut Mesh,
-    faces: usize,
-    config: &ReconstructConfig,
-) -> Result<(), PipelineError> {
-    let untangled = untangle(mesh, &untangle_options(config));
-    fill_to_budget(mesh, faces);
-    match untangled.unresolved_faces.len() {
-        0 => Ok(()),
-        n => Err(PipelineError::Intersections(n)),
-    }
+    let reached = decimate_to_exact_budget(mesh, faces, &options, decimate)?;
+    stats.finish.handles_removed.extend(reached.handles_removed);
+    Ok(reached.decimate)
 }
 
 /// `config.final_smoothing_sweeps` sweeps of tangential smoothing with every move limited so
@@ -523,6 +426,7 @@ mod tests {
     use roar_mesh::spatial::Aabb;
     use roar_mesh::spatial::count_intersecting_faces;
     use roar_mesh::spatial::triangle_quality;
+    use roar_ops::finish::best_state::fill_and_untangle;
     use roar_ops::finish::fill::bisects_well;
     use roar_ops::geometry::{DEGENERATE_QUALITY, is_degenerate};
 
@@ -624,15 +528,16 @@ mod tests {
             faces,
             ..ReconstructConfig::default()
         };
-        let mut stats = RunStats::default();
-        let unresolved = fill_and_untangle(&mut mesh, None, &config, &mut stats);
-        assert_eq!(unresolved, 0);
+        let options = BestStateOptions {
+            faces,
+            untangle: untangle_options(&config),
+            field_epsilon: config.loss.sdf_loss_epsilon,
+        };
+        let stats = fill_and_untangle(&mut mesh, None, &options);
+        assert_eq!(stats.unresolved_faces, 0);
         // The mesh started at the budget, so every split refilled a face the untangle removed.
-        assert!(stats.finish.untangle_initial_pairs > 0);
-        assert!(
-            stats.finish.fill_splits > 0,
-            "the untangle collapsed nothing"
-        );
+        assert!(stats.untangle_initial_pairs > 0);
+        assert!(stats.fill_splits > 0, "the untangle collapsed nothing");
         mesh.validate().unwrap();
         assert_eq!(mesh.n_faces(), faces);
         assert!(count_intersecting_faces(&mesh) == 0);
