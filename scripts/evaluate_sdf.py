@@ -19,7 +19,7 @@ def extract(roar, field, mesh, resolution, bounds):
     if os.path.exists(mesh) and os.path.exists(info_path):
         with open(info_path) as f:
             return json.load(f)
-    cmd = [roar, "extract", field, "-o", mesh, "--resolution", str(resolution)]
+    cmd = [roar, "extract", field, "-o", mesh, "--resolution", str(resolution), "--json"]
     if bounds:
         cmd += ["--bounds", bounds]
     proc, seconds, peak = timed(cmd)

@@ -100,7 +100,8 @@ fn a_range_image_is_a_mesh_to_info_and_a_set_folder_writes_its_patches() {
     );
     let out = dir.path().join("patches.ply");
     let folder = dir.path().display().to_string();
-    let (ok, stdout, stderr) = roar(&["scans", &folder, "-o", &out.display().to_string()]);
+    let (ok, stdout, stderr) =
+        roar(&["scans", &folder, "-o", &out.display().to_string(), "--json"]);
     assert!(ok, "{stderr}");
     let soup = roar_io::read_mesh(&out).unwrap();
     assert_eq!(soup.triangles.len(), 8);

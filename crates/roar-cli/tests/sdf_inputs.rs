@@ -442,6 +442,7 @@ fn extract_writes_the_closed_zero_set_and_reports_its_evaluations() {
         output.to_str().unwrap(),
         "--resolution",
         "24",
+        "--json",
     ]);
     assert!(
         out.status.success(),

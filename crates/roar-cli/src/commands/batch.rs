@@ -230,6 +230,7 @@ fn reconstruct_args(
         no_icp: false,
         report: None,
         print_config: false,
+        json: false,
         quiet: true,
         force: false,
         preview: None,

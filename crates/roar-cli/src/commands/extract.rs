@@ -31,6 +31,10 @@ pub struct ExtractArgs {
     /// `-1.1,-1.1,-1.1,1.1,1.1,1.1`), as for `roar reconstruct`.
     #[arg(long, value_parser = super::reconstruct::parse_bounds, allow_hyphen_values = true)]
     pub bounds: Option<Aabb>,
+    /// Print the costs as one JSON line on stdout (grid, evaluations, seconds, counts) instead
+    /// of the summary.
+    #[arg(long)]
+    pub json: bool,
 }
 
 /// The JSON line `roar extract` prints.
@@ -82,6 +86,19 @@ pub fn run(args: &ExtractArgs) -> anyhow::Result<()> {
         seconds_total: started.elapsed().as_secs_f64(),
         ..report
     };
-    println!("{}", serde_json::to_string(&report)?);
+    if args.json {
+        println!("{}", serde_json::to_string(&report)?);
+    } else {
+        println!(
+            "wrote {} ({} faces, grid {}x{}x{}, {} evaluations) in {:.1} s",
+            args.output.display(),
+            report.faces,
+            report.dims[0],
+            report.dims[1],
+            report.dims[2],
+            report.values + report.gradients,
+            report.seconds_total
+        );
+    }
     Ok(())
 }

@@ -63,7 +63,7 @@ pub struct ReconstructArgs {
     /// Range scans: keep the `.conf` poses (no ICP).
     #[arg(long)]
     pub no_icp: bool,
-    /// Also write the JSON report to this file.
+    /// Write the JSON report to this file.
     #[arg(long)]
     pub report: Option<PathBuf>,
     /// Also write a PNG picture: input and output from the same four views (the output with its
@@ -74,7 +74,10 @@ pub struct ReconstructArgs {
     /// Print the effective configuration as TOML and exit.
     #[arg(long)]
     pub print_config: bool,
-    /// No progress bar and no report on stdout (for scripts).
+    /// Print the JSON report on stdout instead of the summary (`--report` also writes it).
+    #[arg(long)]
+    pub json: bool,
+    /// No progress and no summary (for scripts); errors still go to stderr.
     #[arg(long, short)]
     pub quiet: bool,
     /// Run even when the estimated memory of the budget exceeds what this machine has.
@@ -248,7 +251,8 @@ pub fn run(args: &ReconstructArgs) -> anyhow::Result<()> {
     )
 }
 
-/// Writes the mesh and the report (all or nothing), the preview, and prints the report.
+/// Writes the mesh and the report (all or nothing) and the preview, then prints the summary (or
+/// the report with `--json`) on stdout.
 fn write_outputs(
     args: &ReconstructArgs,
     report: &ReconstructReport,
@@ -281,16 +285,65 @@ fn write_outputs(
             &crate::preview::PreviewOptions::default(),
         )?;
     }
-    if !args.quiet {
+    if args.json {
         println!("{json}");
+    } else if !args.quiet {
+        print!("{}", summary(args, report));
     }
-    eprintln!(
-        "wrote {} ({} faces) in {:.1} s",
-        output.display(),
-        out_soup.triangles.len(),
-        report.seconds_total
-    );
     Ok(())
+}
+
+/// The few lines a person reads after a run: what was written where, its topology, its distance
+/// to the input and the time taken.
+fn summary(args: &ReconstructArgs, report: &ReconstructReport) -> String {
+    let out = &report.output_metrics;
+    let topology = &out.topology;
+    let genus = topology
+        .genus
+        .map_or_else(|| "-".to_string(), |g| g.to_string());
+    let closed = if topology.watertight {
+        "closed"
+    } else {
+        "NOT closed"
+    };
+    let crossing = out
+        .self_intersections
+        .as_ref()
+        .map_or_else(|| "-".to_string(), |s| s.faces.to_string());
+    let mut text = format!("wrote {} in {:.1} s\n", report.output, report.seconds_total);
+    text += &format!(
+        "  mesh      {} faces, {closed}, {} piece(s), genus {genus}, {crossing} self-intersecting faces\n",
+        topology.faces, topology.components,
+    );
+    if let Some(fidelity) = &out.fidelity {
+        text += &format!(
+            "  fidelity  Chamfer/diag to the input {:.3e} (exact closest points {:.3e}), normal cosine {:.4}\n",
+            fidelity.chamfer_l2_over_diag,
+            fidelity.chamfer_exact_over_diag,
+            fidelity.normal_cosine_exact_abs,
+        );
+    }
+    if let Some(sdf) = &report.sdf {
+        text += &format!(
+            "  field     mean distance of the vertices to the zero set {:.3e}, {} evaluations\n",
+            sdf.output_distance_mean,
+            sdf.evaluations.values.values().sum::<u64>()
+                + sdf.evaluations.gradients.values().sum::<u64>()
+        );
+    }
+    let removed = report.run.finish.handles_removed.len();
+    if removed > 0 {
+        text += &format!(
+            "  handles   {removed} removed to reach the budget (--keep-topology fails instead)\n"
+        );
+    }
+    if let Some(path) = &args.report {
+        text += &format!("  report    {}\n", path.display());
+    }
+    if let Some(path) = &args.preview {
+        text += &format!("  preview   {}\n", path.display());
+    }
+    text
 }
 
 /// The file name of `path` for messages and reports.

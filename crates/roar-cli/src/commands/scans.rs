@@ -24,7 +24,10 @@ pub struct ScansArgs {
     /// filters).
     #[arg(long)]
     pub config: Option<PathBuf>,
-    /// No report on stdout.
+    /// Print each scan's patch and alignment as JSON on stdout instead of the summary.
+    #[arg(long)]
+    pub json: bool,
+    /// No summary on stdout.
     #[arg(long, short)]
     pub quiet: bool,
 }
@@ -56,14 +59,15 @@ pub fn run(args: &ScansArgs) -> anyhow::Result<()> {
             scan.file
         );
     }
-    if !args.quiet {
+    if args.json {
         println!("{}", serde_json::to_string_pretty(&scans.reports)?);
+    } else if !args.quiet {
+        println!(
+            "wrote {} ({} scans, {} triangles)",
+            args.output.display(),
+            scans.patches.len(),
+            union.triangles.len()
+        );
     }
-    eprintln!(
-        "wrote {} ({} scans, {} triangles)",
-        args.output.display(),
-        scans.patches.len(),
-        union.triangles.len()
-    );
     Ok(())
 }
