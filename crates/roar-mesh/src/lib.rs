@@ -44,5 +44,5 @@ pub use error::{BuildError, Element, MeshError, TopoError, ValidationError};
 pub use glam::DVec3;
 pub use handles::{EdgeId, FaceId, HalfedgeId, VertexId};
 pub use mesh::{DEGENERATE_CROSS, DEGENERATE_NORMAL, Mesh};
-pub use ops::{Collapse, EdgeSplit, FaceSplit};
+pub use ops::{Collapse, EdgeSplit, FaceSplitOutcome};
 pub use tracked::{NoStore, TrackedMesh, VertexStore};

@@ -14,7 +14,7 @@ use crate::compact::Remap;
 use crate::error::TopoError;
 use crate::handles::{EdgeId, FaceId, HalfedgeId};
 use crate::mesh::Mesh;
-use crate::ops::{Collapse, EdgeSplit, FaceSplit};
+use crate::ops::{Collapse, EdgeSplit, FaceSplitOutcome};
 
 /// Per-vertex data notified of the mesh's vertex changes (each method is called after the
 /// change, with the operator's outcome record).
@@ -27,7 +27,7 @@ pub trait VertexStore {
     /// An edge split added `split.new_vertex` between its two parents.
     fn on_edge_split(&mut self, split: &EdgeSplit);
     /// A face split added `split.new_vertex` inside its three parents.
-    fn on_face_split(&mut self, split: &FaceSplit);
+    fn on_face_split(&mut self, split: &FaceSplitOutcome);
     /// The mesh was compacted: old vertex slot `i` is now `remap.vertices[i]` (or gone).
     fn on_compact(&mut self, remap: &Remap);
 }
@@ -40,7 +40,7 @@ impl VertexStore for NoStore {
     fn on_grow(&mut self, _vertex_slots: usize) {}
     fn on_collapse(&mut self, _collapse: &Collapse) {}
     fn on_edge_split(&mut self, _split: &EdgeSplit) {}
-    fn on_face_split(&mut self, _split: &FaceSplit) {}
+    fn on_face_split(&mut self, _split: &FaceSplitOutcome) {}
     fn on_compact(&mut self, _remap: &Remap) {}
 }
 
@@ -74,7 +74,7 @@ impl<'a> TrackedMesh<'a> {
     }
 
     /// [`Mesh::split_face`], then [`VertexStore::on_grow`] and [`VertexStore::on_face_split`].
-    pub fn split_face(&mut self, f: FaceId, bary: [f64; 3]) -> FaceSplit {
+    pub fn split_face(&mut self, f: FaceId, bary: [f64; 3]) -> FaceSplitOutcome {
         let split = self.mesh.split_face(f, bary);
         self.store.on_grow(self.mesh.vertex_capacity());
         self.store.on_face_split(&split);

@@ -7,7 +7,8 @@
 
 use proptest::prelude::*;
 use roar_mesh::{
-    Collapse, DVec3, EdgeSplit, FaceSplit, Mesh, NoStore, Remap, TrackedMesh, VertexStore, shapes,
+    Collapse, DVec3, EdgeSplit, FaceSplitOutcome, Mesh, NoStore, Remap, TrackedMesh, VertexStore,
+    shapes,
 };
 
 /// A store whose row per vertex slot is where it believes the vertex is, plus call counts.
@@ -35,7 +36,7 @@ impl VertexStore for Positions {
         self.calls[1] += 1;
     }
 
-    fn on_face_split(&mut self, split: &FaceSplit) {
+    fn on_face_split(&mut self, split: &FaceSplitOutcome) {
         let [a, b, c] = split.parents.map(|v| self.rows[v.index()]);
         self.rows[split.new_vertex.index()] =
             a * split.bary[0] + b * split.bary[1] + c * split.bary[2];

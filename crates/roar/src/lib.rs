@@ -58,7 +58,9 @@ pub use config::{
 pub use error::PipelineError;
 pub use objective::{LossFactory, Prepared, default_loss, planar_options};
 pub use reconstruction::{Output, Reconstruction};
-pub use report::{FinishStats, InitStats, IterationRecord, OptimizeStats, RunStats, TargetStats};
+pub use report::{
+    FinishReport, InitReport, IterationRecord, OptimizeReport, RunStats, TargetReport,
+};
 pub use rig::{coarse_rig_cameras, rig_cameras, target_options};
 pub use run::Progress;
 pub use schedule::{ScheduledBlock, default_blocks};

@@ -86,9 +86,9 @@ impl Reconstruction {
             progress,
             cancel: self.cancel.clone(),
         };
-        let target = prepare::prepare(shape, &mut run)?;
+        let rig = prepare::prepare(shape, &mut run)?;
         let (mesh, cloud) = init::init(shape, &mut run)?;
-        let objective = optimize::objective(shape, &target, &cloud, &self.loss_factory, &mut run)?;
+        let objective = optimize::objective(shape, &rig, &cloud, &self.loss_factory, &mut run)?;
         let block_projector: &dyn Projector = shape.projector().unwrap_or(&objective.projector);
         let mut loss = objective.loss;
         let states = optimize::optimize(
@@ -103,12 +103,12 @@ impl Reconstruction {
             loss,
             &objective.projector,
             shape.signed_distance().as_deref(),
-            &target.normalization,
+            &rig.normalization,
             &mut run,
         )?;
 
         let (mut positions, triangles) = mesh.to_triangles();
-        target.normalization.invert_all(&mut positions);
+        rig.normalization.invert_all(&mut positions);
         let mut stats = run.stats;
         stats.seconds = run.clock.seconds;
         Ok(Output {

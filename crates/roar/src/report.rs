@@ -12,18 +12,18 @@ pub struct RunStats {
     /// Seconds per stage, in first-run order of stage names (sorted by name in JSON).
     pub seconds: BTreeMap<String, f64>,
     /// What the target preparation made (the `[target]` stage).
-    pub target: TargetStats,
+    pub target: TargetReport,
     /// The initial mesh M0 (the `[init]` stage).
-    pub init: InitStats,
+    pub init: InitReport,
     /// The loop at the working budget (the `[optimize]` stage).
-    pub optimize: OptimizeStats,
+    pub optimize: OptimizeReport,
     /// From the loop's mesh to exactly N faces (the `[finish]` stage).
-    pub finish: FinishStats,
+    pub finish: FinishReport,
 }
 
 /// What the target preparation made (the `[target]` stage).
 #[derive(Debug, Clone, Default, Serialize)]
-pub struct TargetStats {
+pub struct TargetReport {
     /// Faces of the cleaned target T′.
     pub target_faces: usize,
     /// Twins dropped by the pixel-count rule.
@@ -34,7 +34,7 @@ pub struct TargetStats {
 
 /// The initial mesh M0 (the `[init]` stage).
 #[derive(Debug, Clone, Default, Serialize)]
-pub struct InitStats {
+pub struct InitReport {
     /// Faces of the voxel surface before any decimation.
     pub init_voxel_faces: usize,
     /// Faces of M0 after QEM to ≤ init_max_faces.
@@ -54,7 +54,7 @@ pub struct InitStats {
 
 /// The loop at the working budget (the `[optimize]` stage).
 #[derive(Debug, Clone, Default, Serialize)]
-pub struct OptimizeStats {
+pub struct OptimizeReport {
     /// The working budget W.
     pub working_budget: usize,
     /// Loss at the first and last iteration.
@@ -85,7 +85,7 @@ pub struct OptimizeStats {
 
 /// From the loop's mesh to exactly N faces (the `[finish]` stage).
 #[derive(Debug, Clone, Default, Serialize)]
-pub struct FinishStats {
+pub struct FinishReport {
     /// Untangle statistics.
     pub untangle_initial_pairs: usize,
     /// Rounds the untangle block needed.

@@ -20,7 +20,7 @@ mod split_face;
 
 pub use collapse::Collapse;
 pub use split_edge::EdgeSplit;
-pub use split_face::FaceSplit;
+pub use split_face::FaceSplitOutcome;
 
 use crate::error::{Element, TopoError};
 use crate::handles::{EdgeId, FaceId, HalfedgeId};

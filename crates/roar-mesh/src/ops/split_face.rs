@@ -5,7 +5,7 @@ use crate::mesh::Mesh;
 
 /// Outcome of [`Mesh::split_face`].
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct FaceSplit {
+pub struct FaceSplitOutcome {
     /// The new vertex, at `Σ bary[i] · position(parents[i])`.
     pub new_vertex: VertexId,
     /// The split face's corners, as [`Mesh::face_vertices`] returned them before the split.
@@ -35,7 +35,7 @@ impl Mesh {
     ///
     /// # Panics
     /// If `f` is dead or from another mesh (a caller bug, like an out-of-range index).
-    pub fn split_face(&mut self, f: FaceId, bary: [f64; 3]) -> FaceSplit {
+    pub fn split_face(&mut self, f: FaceId, bary: [f64; 3]) -> FaceSplitOutcome {
         assert!(
             self.is_face_alive(f),
             "split_face: {f:?} is dead or out of range"
@@ -63,7 +63,7 @@ impl Mesh {
 
         self.set_vertex_halfedge(m, e0.twin());
         self.paranoid_check("split_face");
-        FaceSplit {
+        FaceSplitOutcome {
             new_vertex: m,
             parents,
             bary,

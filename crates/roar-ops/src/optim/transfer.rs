@@ -20,7 +20,7 @@
 //! `grow`. Removed vertices keep their (stale) rows until `apply_remap` drops them; `step`
 //! ignores them meanwhile because no triangle references them.
 
-use roar_mesh::{Collapse, EdgeSplit, FaceSplit, Remap, VertexStore};
+use roar_mesh::{Collapse, EdgeSplit, FaceSplitOutcome, Remap, VertexStore};
 
 use super::{OptimError, Optimizer, VertexState};
 
@@ -45,7 +45,7 @@ impl VertexStore for Optimizer {
             .expect(ROWS_COVER_SLOTS);
     }
 
-    fn on_face_split(&mut self, split: &FaceSplit) {
+    fn on_face_split(&mut self, split: &FaceSplitOutcome) {
         let parents = split.parents.map(|v| v.raw());
         Optimizer::on_face_split(self, split.new_vertex.raw(), parents).expect(ROWS_COVER_SLOTS);
     }

@@ -20,7 +20,7 @@ use crate::rig::coarse_rig_cameras;
 use crate::run::{Run, StageClock};
 use crate::schedule::ScheduledBlock;
 use crate::shape::Shape;
-use crate::stages::prepare::Target;
+use crate::stages::prepare::Rig;
 
 /// The loss the loop minimizes and the k-NN planar projector over the point cloud (the
 /// blocks' projector unless the shape has its own, and the data flips' normals).
@@ -32,13 +32,13 @@ pub(crate) struct Objective {
 /// Builds the objective from the shape's target renders and `cloud` with `loss_factory`.
 pub(crate) fn objective(
     shape: &dyn Shape,
-    target: &Target,
+    rig: &Rig,
     cloud: &PointCloud,
     loss_factory: &LossFactory,
     run: &mut Run,
 ) -> Result<Objective, PipelineError> {
     let config = run.config;
-    let cameras = &target.cameras;
+    let cameras = &rig.cameras;
     let renders = target_renders(shape, cameras)?;
     let coarse_cameras = coarse_rig_cameras(config);
     let coarse_renders = target_renders(shape, &coarse_cameras)?;

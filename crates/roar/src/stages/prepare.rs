@@ -10,7 +10,7 @@ use crate::run::Run;
 use crate::shape::Shape;
 
 /// What the prepare stage hands on: the rig and the input's normalization.
-pub(crate) struct Target {
+pub(crate) struct Rig {
     /// The camera rig ([`rig_cameras`]), for which the shape renders its target.
     pub cameras: Vec<Camera>,
     /// Input → rig coordinates; inverted on the output.
@@ -18,7 +18,7 @@ pub(crate) struct Target {
 }
 
 /// Prepares `shape` for the rig of `run.config` and records the target's figures.
-pub(crate) fn prepare(shape: &mut dyn Shape, run: &mut Run) -> Result<Target, PipelineError> {
+pub(crate) fn prepare(shape: &mut dyn Shape, run: &mut Run) -> Result<Rig, PipelineError> {
     run.report("target", 0, f64::NAN, 0)?;
     let cameras = rig_cameras(run.config);
     shape.prepare(&cameras)?;
@@ -27,7 +27,7 @@ pub(crate) fn prepare(shape: &mut dyn Shape, run: &mut Run) -> Result<Target, Pi
     run.stats.target.target_faces = summary.target_faces;
     run.stats.target.twins_dropped = summary.twins_dropped;
     run.clock.lap("target");
-    Ok(Target {
+    Ok(Rig {
         cameras,
         normalization,
     })
