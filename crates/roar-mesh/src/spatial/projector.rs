@@ -1,5 +1,6 @@
 //! Projection of source-mesh samples onto the target surface along their normals, which the
 //! Face Split block scores faces with (`docs/method.md#projection-onto-the-target`).
+//!
 //! One concept, several implementations: k-NN planar projection over the target point cloud (the
 //! paper's, in `roar-loss`), exact ray casting onto the target soup guarded by winding numbers of
 //! the source (the authors' later code, in `spatial`), and the analytic [`SphereProjector`] here, a
