@@ -49,8 +49,8 @@ pub const DEFAULT_PLANAR_SCALE: f64 = 5.0;
 /// stochastic grid rounding), 6.1% at 100k, 8.7% at 50k, 13.5% at 25k, 20% at 12.5k. The samples
 /// are drawn afresh at every evaluation, so this error averages out over the iterations; one
 /// evaluation at 12.5k costs about a third of one at 50k (the k-NN queries and the t2s tree scale
-/// with the sample count, the t2s queries of the target points do not). Its effect on `roar
-/// reconstruct`'s outputs: `docs/method.md#planar-loss`.
+/// with the sample count, the t2s queries of the target points do not). Its effect on
+/// `roar reconstruct`'s outputs: `docs/method.md#planar-loss`.
 pub const DEFAULT_MAX_SAMPLES: usize = 12_500;
 
 /// Default cap on the target points the t2s term queries per evaluation

@@ -2,8 +2,8 @@
 //!
 //! Naming: a *sample* is a point on a face with its face index, barycentric coordinates (corner
 //! order of the face) and the unit normal of its face. As in the authors' code, faces are drawn
-//! with probability proportional to area, barycentrics are `(1−√u, √u(1−v), √u·v)` with `u, v ~
-//! U(0, 1)`. Same input and seed give the same samples on every machine.
+//! with probability proportional to area, barycentrics are `(1−√u, √u(1−v), √u·v)` with
+//! `u, v ~ U(0, 1)`. Same input and seed give the same samples on every machine.
 
 use glam::DVec3;
 use rand::{Rng, SeedableRng};

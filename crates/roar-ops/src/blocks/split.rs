@@ -557,12 +557,12 @@ impl EdgeCosts {
 type Chosen = Vec<(f64, EdgeId)>;
 
 /// The block's pairing restricted to the edges that can matter below threshold `t` (see
-/// [`EdgeCosts`]): the independent set over the edges with priority `exp(−C_e) ≥
-/// priority_floor(t)`, its edges with `c_e = max(C_e, P_e) < t` sorted by `(c_e, id)`, and the swap
-/// count k of the pairing with `ranked` (faces by S descending). These agree with the unrestricted
-/// computation (`t = ∞`) on every edge with `c_e < t`. The last value says whether k is also the
-/// unrestricted swap count: yes unless all the returned edges swap and the next face scores above
-/// `t` (it might pair with an edge that was left out).
+/// [`EdgeCosts`]): the independent set over the edges with priority
+/// `exp(−C_e) ≥ priority_floor(t)`, its edges with `c_e = max(C_e, P_e) < t` sorted by `(c_e, id)`,
+/// and the swap count k of the pairing with `ranked` (faces by S descending). These agree with the
+/// unrestricted computation (`t = ∞`) on every edge with `c_e < t`. The last value says whether k
+/// is also the unrestricted swap count: yes unless all the returned edges swap and the next face
+/// scores above `t` (it might pair with an edge that was left out).
 fn pair_edges(
     mesh: &Mesh,
     costs: &EdgeCosts,

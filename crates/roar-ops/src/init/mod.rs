@@ -514,10 +514,10 @@ fn watertight_init_from(
     })
 }
 
-/// Builds a closed, outward-oriented 2-manifold from the cells of a grid over `[bounds_min,
-/// bounds_max]` whose centre has `sdf < 0` (supplementary §3), with the same manifold repair and
-/// boundary extraction as [`watertight_init`]. Interior voids are filled (the exterior is the
-/// region connected to the border). Vertices stay on the grid corners. The cell centres are
+/// Builds a closed, outward-oriented 2-manifold from the cells of a grid over
+/// `[bounds_min, bounds_max]` whose centre has `sdf < 0` (supplementary §3), with the same manifold
+/// repair and boundary extraction as [`watertight_init`]. Interior voids are filled (the exterior
+/// is the region connected to the border). Vertices stay on the grid corners. The cell centres are
 /// evaluated in one batch of values ([`Sdf::values`]; no gradients); a NaN counts as outside.
 pub fn sdf_init(
     sdf: &dyn Sdf,
