@@ -176,7 +176,7 @@ fn a_component_whose_first_gradient_was_zero_still_moves_later() {
 #[test]
 fn reference_clamping_freezes_a_component_whose_first_gradient_was_zero() {
     let (dy, clamped) = y_motion_after_a_late_nonzero_component(false);
-    assert_eq!(dy, 0.0, "switch off: the y component stays frozen (the authors' clamp)");
+    assert_eq!(dy, 0.0, "authors' clamp: the y component stays frozen");
     assert_eq!(
         clamped,
         6 * 5,
