@@ -1,4 +1,4 @@
-//! The planar loss's k-nearest-neighbour queries (spec §3.2.2): roar's own k-d tree
+//! The planar loss's k-nearest-neighbour queries: roar's own k-d tree
 //! (`roar_loss::point_tree`, behind `KnnPlanarProjector`) against kiddo's `ImmutableKdTree`
 //! (f32 coordinates like ours, buckets of 32), each doing the queries of the s2t moves of one
 //! planar-loss evaluation; and the whole evaluation (value and gradient) for scale.

@@ -1,4 +1,4 @@
-//! One evaluation of the loop's objective (spec §3.2.3: `3·L_render + 1·L_planar`, built by
+//! One evaluation of the loop's objective (`3·L_render + 1·L_planar`, built by
 //! `roar::default_loss`) on a real mesh, and its parts on their own. A soup's loop
 //! and polish render the default rig coarse (25 views × 256², `render_coarse_resolution`), the
 //! paper the full rig (36 × 512², the SDF and scan schedules): `loop_*` and `render_coarse_*`

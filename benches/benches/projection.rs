@@ -1,13 +1,13 @@
-//! The supplementary's Fig. 1 (spec §3.2.2, §7.2): error and time of the k-NN planar projection
-//! (spec §3.4 (A)) with 10k, 50k and 200k target samples against the exact ray-cast projection
-//! onto the target mesh (spec §3.4 (B)), for source meshes of about 1k, 10k and 100k faces; plus
-//! the per-evaluation cost of the planar loss (value and gradient) at 5k faces, at the default
+//! The supplementary's Fig. 1 (supplementary §1.4): error and time of the k-NN planar projection
+//! (the paper's) with 10k, 50k and 200k target samples against the exact ray-cast projection onto
+//! the target mesh (the authors' later code), for source meshes of about 1k, 10k and 100k faces;
+//! plus the per-evaluation cost of the planar loss (value and gradient) at 5k faces, at the default
 //! sample cap and at 100k.
 //!
 //! Target: a bumpy sphere (icosphere(6), 81 920 faces, radius 0.8 modulated by
 //! `1 + 0.04·sin(6x)sin(6y)sin(6z)`). Sources: geodesic spheres of 980, 9 680 and 100 820 faces
 //! carrying the same bumps at radius 0.79, so every sample lies within the 0.05 reach of the
-//! exact projector, as during optimization. Samples: the source's regular samples (spec §3.3),
+//! exact projector, as during optimization. Samples: the source's regular samples,
 //! capped at 50k per source by the planar loss's stratified subsampling. The error table (mean
 //! `|q_knn − q_exact|` over samples valid for both, divided by the target's bounding-box
 //! diagonal) is printed once before the timings.

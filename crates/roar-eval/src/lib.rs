@@ -1,6 +1,7 @@
 //! # roar-eval
 //!
-//! Metrics on arbitrary triangle soups (spec §6.1), on plain buffers (`&[DVec3]`, `&[[u32; 3]]`):
+//! Metrics on arbitrary triangle soups (those of supplementary §1.1 and more;
+//! `docs/method.md#evaluation-metrics`), on plain buffers (`&[DVec3]`, `&[[u32; 3]]`):
 //!
 //! - [`topology`]: boundary edges and loops, non-manifold edges and vertices, inconsistent winding,
 //!   duplicates, degenerate faces, components, watertightness, Euler characteristic, genus, with the
@@ -12,7 +13,7 @@
 //!   each both to the other side's nearest sample (k-d tree) and to the other mesh's exact closest
 //!   point (BVH).
 //! - [`self_intersections`]: faces intersecting a non-adjacent face (exact, on the welded mesh),
-//!   and the paper's ε-offset variant.
+//!   and the paper's ε-offset variant (supplementary §1.1).
 //! - [`evaluate`] gathers everything in a serde [`Report`].
 
 mod fidelity;

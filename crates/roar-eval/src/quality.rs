@@ -1,9 +1,10 @@
-//! Triangle shape quality: the aspect ratio `Q = R_circ / (2 r_in)` (spec §2, §6.1.3).
+//! Triangle shape quality: the aspect ratio `Q = R_circ / (2 r_in)` (supplementary §1.1).
 
 use glam::DVec3;
 use serde::Serialize;
 
-/// Aspect-ratio statistics over the non-degenerate faces (spec §6.1.3: the median is the metric).
+/// Aspect-ratio statistics over the non-degenerate faces; the median is the
+/// paper's metric (supplementary §1.1).
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct QualityStats {
     /// Median Q (mean of the two middle values for an even count); `None` without any valid face.

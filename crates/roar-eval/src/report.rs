@@ -1,4 +1,4 @@
-//! The evaluation report: every metric of spec §6.1 for one mesh, optionally against a reference.
+//! The evaluation report: every metric of `roar eval` for one mesh, optionally against a reference.
 
 use glam::DVec3;
 use serde::Serialize;
@@ -14,9 +14,9 @@ use crate::topology::{TopologyStats, signed_volume, topology, weld_bit_identical
 /// What [`evaluate`] computes and how.
 #[derive(Debug, Clone, PartialEq)]
 pub struct EvalOptions {
-    /// Sampling for Chamfer, Hausdorff and normal similarity (spec §6.1.1–2).
+    /// Sampling for Chamfer, Hausdorff and normal similarity.
     pub chamfer: ChamferOptions,
-    /// Self-intersections (spec §6.1.4) with these options, or `None` to skip them (they cost a
+    /// Self-intersections with these options, or `None` to skip them (they cost a
     /// BVH pass and exact tests; on by default).
     pub self_intersections: Option<SelfIntersectionOptions>,
 }

@@ -1,5 +1,5 @@
-//! Self-intersecting faces (spec §6.1.4), counted the way `SOURCES.md`'s `selfX` column (MeshLab)
-//! counts them, plus the seed paper's ε-offset variant.
+//! Self-intersecting faces, counted the way `SOURCES.md`'s `selfX` column (MeshLab)
+//! counts them, plus the paper's ε-offset variant (supplementary §1.1).
 //!
 //! Rules, all on the mesh welded at bit-identical positions ([`crate::weld_bit_identical`]):
 //! - faces sharing a welded vertex or edge are *adjacent*; an adjacent pair intersects only when
@@ -16,11 +16,12 @@ use serde::Serialize;
 
 use crate::fidelity::bbox_diagonal;
 
-/// How the ε-offset re-test of spec §6.1.4 is done.
+/// How the ε-offset re-test is done: a face whose intersections vanish once every vertex
+/// moves by ε along its normal does not count (supplementary §1.1).
 #[derive(Debug, Clone, PartialEq)]
 pub struct SelfIntersectionOptions {
     /// The offset ε along each vertex normal, as a fraction of the bounding-box diagonal of the
-    /// referenced vertices (spec §6.1.4: ε ≈ 1e-5 × bbox diagonal).
+    /// referenced vertices. Default 1e-5; the paper does not give ε.
     pub offset_over_diagonal: f64,
 }
 
@@ -32,7 +33,7 @@ impl Default for SelfIntersectionOptions {
     }
 }
 
-/// Self-intersecting faces of one mesh (spec §6.1.4).
+/// Self-intersecting faces of one mesh.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct SelfIntersectionStats {
     /// Faces (of the welded mesh, non-degenerate ones only) that intersect at least one other

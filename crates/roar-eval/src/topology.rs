@@ -1,5 +1,6 @@
 //! Combinatorial topology of a triangle soup: boundary, non-manifold edges and vertices, winding
-//! consistency, duplicates, components, Euler characteristic and genus (spec §6.1.5–6).
+//! consistency, duplicates, components, Euler characteristic and genus; the
+//! non-manifold counts are the paper's metrics (supplementary §1.1).
 //!
 //! Counting rules follow `SOURCES.md` ("How the figures were measured") of the shared test data:
 //! topology is computed over the triangles whose three vertex indices are distinct; a triangle with a

@@ -367,14 +367,15 @@ fn add_primitive(
                 push(t[0], t[1], t[2]);
             }
         }
-        // glTF 2.0 §3.7.2.1: strip triangle i is (v_i, v_{i+1+i%2}, v_{i+2-i%2}).
+        // glTF 2.0 specification, section 3.7.2.1:
+        // strip triangle i is (v_i, v_{i+1+i%2}, v_{i+2-i%2}).
         Mode::TriangleStrip => {
             for i in 0..k.saturating_sub(2) {
                 let odd = i % 2;
                 push(corners[i], corners[i + 1 + odd], corners[i + 2 - odd]);
             }
         }
-        // glTF 2.0 §3.7.2.1: fan triangle i is (v_{i+1}, v_{i+2}, v_0).
+        // glTF 2.0 specification, section 3.7.2.1: fan triangle i is (v_{i+1}, v_{i+2}, v_0).
         Mode::TriangleFan => {
             for i in 0..k.saturating_sub(2) {
                 push(corners[i + 1], corners[i + 2], corners[0]);

@@ -1,6 +1,7 @@
-//! Loss balance (Verification note 2): gradient norms of the render loss and of the raw planar
-//! loss on an icosphere source of radius 0.5 against a sphere target of radius R, so the default
-//! `PlanarOptions::scale` can be chosen to make both terms comparable at weight 1.
+//! Loss balance (`docs/method.md#decision-balance-of-the-planar-term`): gradient norms of the
+//! render loss and of the raw planar loss on an icosphere source of radius 0.5 against a sphere
+//! target of radius R, so the default `PlanarOptions::scale` can be chosen to make both terms
+//! comparable at weight 1.
 //!
 //! Run: `cargo run -p roar-loss --example planar_balance [resolution] [levels...]`.
 

@@ -1,4 +1,4 @@
-//! Cost of one planar loss evaluation (spec §3.2.2) at about 5k faces, for profiling.
+//! Cost of one planar loss evaluation at about 5k faces, for profiling.
 //!
 //! Target: a bumpy sphere (icosphere(6), radius 0.8, modulated by
 //! `1 + 0.04·sin(6x)sin(6y)sin(6z)`) sampled with `P` points; source: icosphere(4) (5 120 faces)

@@ -1,5 +1,6 @@
-//! k-NN planar projection of source samples onto an oriented target point cloud (spec §3.4 (A)
-//! and the source→target term of §3.2.2).
+//! k-NN planar projection of source samples onto an oriented target point cloud: the paper's
+//! projector of the Face Split block (supplementary §1.4) and the source→target term of the
+//! planar loss (`docs/method.md#planar-loss`).
 //!
 //! Each sample `s` with unit normal `n` looks up its `k` nearest target points `t_j` (normals
 //! `m_j`), intersects the line `s + α n` with each neighbour's tangent plane, keeps the valid
@@ -18,14 +19,15 @@ use crate::point_tree::{Neighbours, PointTree};
 /// Samples per parallel work item (coarse: the machine has few cores).
 const CHUNK: usize = 2048;
 
-/// Added to squared distances before inverting them into weights (spec §3.2.2 step 3).
+/// Added to squared distances before inverting them into weights (the authors' code's value).
 const WEIGHT_EPSILON: f64 = 1e-5;
 
-/// How a sample's move is built from its valid neighbours (spec OQ-3 switches).
+/// How a sample's move is built from its valid neighbours; the variants other than the default
+/// are for ablations (`docs/method.md#decision-form-of-the-planar-loss`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum PlanarMode {
     /// Along the sample normal onto each neighbour's plane, inverse-squared-distance blend
-    /// (spec §3.2.2 s2t, the default).
+    /// (the default).
     #[default]
     AlongNormal,
     /// Orthogonally onto each neighbour's plane, `((t_j − s)·m_j) m_j`, same validity and
@@ -33,20 +35,21 @@ pub enum PlanarMode {
     /// ablations of the loss only).
     Orthogonal,
     /// Along the sample normal, but only the valid neighbour with the smallest |move|
-    /// (spec §3.2.2 "alternative mode").
+    /// (an alternative mode of the authors' code).
     Nearest,
 }
 
-/// Options of the k-NN planar projection (spec §3.2.2 s2t, §3.4 (A)).
+/// Options of the k-NN planar projection.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct KnnOptions {
-    /// Number of nearest target points per sample. Default 10 (spec §3.2.2, [SUP]).
+    /// Number of nearest target points per sample. Default 10 (supplementary §1.2).
     pub k: usize,
-    /// A neighbour is valid only if `n·m_j >` this. Default 0.01 (the cfg value of
-    /// `normal_dot_prod_threshold`, spec §3.2.2 step 2).
+    /// A neighbour is valid only if `n·m_j >` this. Default 0.01 (the value of
+    /// `normal_dot_prod_threshold` in the authors' configuration; their code's default is 0.5).
     pub normal_dot_threshold: f64,
     /// Blow-up guard: the projected point must satisfy `|t_j − q| < guard·|t_j − s|`.
-    /// Default 1.01 (spec §3.2.2 step 2).
+    /// Default 1.01 (the authors' code): a projection may not land farther from the neighbour
+    /// than the sample itself, so grazing planes do not blow a move up.
     pub blowup_guard: f64,
     /// How valid neighbours are combined. Default [`PlanarMode::AlongNormal`].
     pub mode: PlanarMode,
@@ -90,7 +93,7 @@ pub(crate) fn check_cloud(points: &[DVec3], normals: &[DVec3]) -> Result<(), Los
     Ok(())
 }
 
-/// k-NN planar projector over a fixed oriented target point cloud (spec §3.4 (A)).
+/// k-NN planar projector over a fixed oriented target point cloud.
 #[derive(Debug, Clone)]
 pub struct KnnPlanarProjector {
     tree: PointTree,
@@ -184,8 +187,8 @@ impl KnnPlanarProjector {
         found.sort_unstable_by_key(|&(j, d2, _)| (d2.to_bits(), j));
     }
 
-    /// The move `d` of sample `s` with unit normal `n` (spec §3.2.2 s2t steps 1–3): `None` when
-    /// no neighbour is valid or the input is not finite.
+    /// The move `d` of sample `s` with unit normal `n`: `None` when no neighbour is valid or the
+    /// input is not finite.
     pub fn displacement(&self, s: DVec3, n: DVec3) -> Option<DVec3> {
         let mut scratch = Neighbours::default();
         let mut found = Vec::new();
@@ -316,7 +319,7 @@ impl Projector for KnnPlanarProjector {
 }
 
 /// The planar move of sample `s` (unit normal `n`) from its neighbours `(t_j, m_j, d_j²)`
-/// (spec §3.2.2 s2t steps 2–3; `mode` picks the OQ-3 variant). `None` when no neighbour is
+/// (`mode` picks the variant). `None` when no neighbour is
 /// valid. Neighbour validity: `n·m_j > threshold` and the blow-up guard on the along-normal
 /// projection (also used to validate the orthogonal variant).
 pub fn planar_move(

@@ -1,9 +1,9 @@
 //! # roar-loss
 //!
-//! The reconstruction target (the cleaned soup T′, its renders, the oriented point cloud P) and
-//! the losses that drive the vertices: the render loss and the planar projection loss (spec
-//! §3.1–§3.4), behind the common [`Loss`] trait so a researcher can add or swap a term without
-//! touching the pipeline.
+//! The reconstruction target (the cleaned soup T′, its renders, the oriented point cloud P) and the
+//! losses that drive the vertices: the render loss, the planar projection loss and the SDF loss
+//! (`docs/method.md#render-loss` and the sections after it), behind the common [`Loss`] trait so a
+//! researcher can add or swap a term without touching the pipeline.
 
 pub mod knn_projector;
 pub mod planar;
@@ -74,7 +74,8 @@ pub trait Loss: Send {
     }
 }
 
-/// A weighted sum of losses, itself a [`Loss`] (spec §3.2.3: `3·L_render + 1·L_planar`).
+/// A weighted sum of losses, itself a [`Loss`] (the paper's objective is `3·L_render + 1·L_planar`,
+/// supplementary §1).
 #[derive(Default)]
 pub struct WeightedSum {
     /// The terms and their weights; evaluated concurrently, summed in this order.

@@ -1,6 +1,8 @@
-//! The planar projection loss `L_planar` (spec §3.2.2, OQ-3, Verification note 2).
+//! The planar projection loss `L_planar`: its form is ours where the paper is silent
+//! (`docs/method.md#decision-form-of-the-planar-loss`), and so is its scale
+//! (`docs/method.md#decision-balance-of-the-planar-term`).
 //!
-//! Every evaluation regularly samples the current source mesh (spec §3.3, sample normals blended
+//! Every evaluation regularly samples the current source mesh (sample normals blended
 //! from ROAR vertex normals), moves each sample toward the target point cloud P along its normal
 //! (k-NN planar projection, the s2t term, plus the t2s term that reaches thin target parts), and
 //! measures `scale · mean_i ‖s_i − sg(s_i + d_i)‖²`. The projected points are constants
@@ -15,7 +17,7 @@ use rand_chacha::ChaCha8Rng;
 use roar_mesh::spatial::regular_sampling::{
     continuous_grid_size, face_grid, grid_point_count, round_grid_size,
 };
-/// The ROAR vertex normals (spec §2.2), a kernel of `roar_mesh::spatial`.
+/// The ROAR vertex normals (area × corner-angle weights), a kernel of `roar_mesh::spatial`.
 pub use roar_mesh::spatial::vertex_normals;
 use roar_mesh::spatial::{RegularSamples, RegularSamplingOptions};
 
@@ -26,7 +28,9 @@ use crate::{Loss, LossError};
 /// Target points per parallel work item of the t2s assignment.
 const CHUNK: usize = 4096;
 
-/// Default of [`PlanarOptions::scale`] (Verification note 2). Measured by
+/// Default of [`PlanarOptions::scale`]: with the raw loss the planar gradient is far below the
+/// render gradient and would do almost nothing
+/// (`docs/method.md#decision-balance-of-the-planar-term`). Measured by
 /// `examples/planar_balance.rs` (36 views at 256², L1 render loss, icosphere source of radius 0.5
 /// against a sphere of radius R, P = 200k exact samples): mean per-vertex gradient norm of the
 /// render loss over the raw planar loss is 15–20 at R − r = 0.01 and 2.8–3.8 at R − r = 0.05
@@ -35,48 +39,49 @@ const CHUNK: usize = 4096;
 /// weight 1, i.e. within 10× over the working range; the planar term still fades as the gap
 /// closes (it is quadratic), the render term does not. `roar reconstruct` passes its own
 /// `planar_scale` (500): on the init of a wild mesh the raw planar gradient is far smaller
-/// against the render gradient than on this sphere (`docs/method.md`).
+/// against the render gradient than on this sphere (same section).
 pub const DEFAULT_PLANAR_SCALE: f64 = 5.0;
 
-/// Default of [`PlanarOptions::max_samples`]: 12 500 source samples per evaluation (spec
-/// §3.2.2: the spec's density gives 150–300k on a typical shape). Measured by
-/// `examples/planar_profile.rs` (`CAP_STUDY=1`; 5 120-face bumpy sphere, 263k regular samples
-/// uncapped): the relative L2 error of one evaluation's gradient against uncapped evaluations
-/// is 5.2% uncapped (the floor set by the stochastic grid rounding), 6.1% at 100k, 8.7% at
-/// 50k, 13.5% at 25k, 20% at 12.5k. The samples are drawn afresh at every evaluation, so this
-/// error averages out over the iterations; one evaluation at 12.5k costs about a third of one
-/// at 50k (the k-NN queries and the t2s tree scale with the sample count, the t2s queries of
-/// the target points do not). Its effect on `roar reconstruct`'s outputs: `docs/method.md`.
+/// Default of [`PlanarOptions::max_samples`]: 12 500 source samples per evaluation (the paper's
+/// density gives 150–300k on a typical shape). Measured by `examples/planar_profile.rs`
+/// (`CAP_STUDY=1`; 5 120-face bumpy sphere, 263k regular samples uncapped): the relative L2 error
+/// of one evaluation's gradient against uncapped evaluations is 5.2% uncapped (the floor set by the
+/// stochastic grid rounding), 6.1% at 100k, 8.7% at 50k, 13.5% at 25k, 20% at 12.5k. The samples
+/// are drawn afresh at every evaluation, so this error averages out over the iterations; one
+/// evaluation at 12.5k costs about a third of one at 50k (the k-NN queries and the t2s tree scale
+/// with the sample count, the t2s queries of the target points do not). Its effect on
+/// `roar reconstruct`'s outputs: `docs/method.md#planar-loss`.
 pub const DEFAULT_MAX_SAMPLES: usize = 12_500;
 
 /// Default cap on the target points the t2s term queries per evaluation
-/// ([`PlanarOptions::t2s_max_points`]). [INF] Every target point's nearest-sample query
-/// (229k on a soup: the cloud plus its sharp-edge samples) is the largest single kernel of a
-/// 1000-face run; a spatially even fifth of them per evaluation, a different fifth each time,
-/// measured on the 14 wild meshes: `docs/method.md`.
+/// ([`PlanarOptions::t2s_max_points`]); the paper queries them all. Every target point's
+/// nearest-sample query (229k on a soup: the cloud plus its sharp-edge samples) is the largest
+/// single kernel of a 1000-face run; a spatially even fifth of them per evaluation, a different
+/// fifth each time, measured on the 14 wild meshes: `docs/method.md#planar-loss`.
 pub const DEFAULT_T2S_MAX_POINTS: usize = 50_000;
 
-/// Options of [`PlanarLoss`] (spec §3.2.2, §3.3, OQ-3).
+/// Options of [`PlanarLoss`] (`docs/method.md#planar-loss`).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct PlanarOptions {
-    /// The s2t k-NN projection (k = 10, threshold 0.01, guard 1.01, mode along-normal; OQ-3).
+    /// The s2t k-NN projection (k = 10, threshold 0.01, guard 1.01, mode along-normal).
     pub knn: KnnOptions,
-    /// Include the target→source term (spec §3.2.2 t2s; default true, OQ-3 "no-t2s" switch).
+    /// Include the target→source term, which reaches thin target parts no sample is near
+    /// (default true; false for ablations).
     pub t2s: bool,
-    /// t2s moves a sample only if `m_{t*}·n_i ≥` this. Default 0.95 (spec §3.2.2 t2s step 3).
+    /// t2s moves a sample only if `m_{t*}·n_i ≥` this. Default 0.95 (the authors' code).
     pub t2s_normal_dot: f64,
     /// Most target points the t2s term queries per evaluation (default
-    /// [`DEFAULT_T2S_MAX_POINTS`]; 0 = all, as the spec). Above it, every `s`-th point of the
+    /// [`DEFAULT_T2S_MAX_POINTS`]; 0 = all, as the paper). Above it, every `s`-th point of the
     /// cloud's spatial order, `s = ⌈points/cap⌉`, from an offset that advances by one per
     /// evaluation, so `s` consecutive evaluations query every point once ([`t2s_subset`]).
     pub t2s_max_points: usize,
-    /// Regular sampling of the source (spec §3.3: δ = 0.002, n ≤ 16, n ≥ 3).
+    /// Regular sampling of the source (δ = 0.002, n ≤ 16, n ≥ 3).
     pub sampling: RegularSamplingOptions,
     /// Cap on source samples per evaluation (default [`DEFAULT_MAX_SAMPLES`]). Above it, every
     /// face keeps a share `cap/total` of its samples (stratified, see [`stratified_subsample`]).
     pub max_samples: usize,
-    /// Multiplies the raw loss `mean_i ‖d_i‖²` and its gradient (Verification note 2).
-    /// 1 is the raw spec loss; the default [`DEFAULT_PLANAR_SCALE`] makes the planar gradient
+    /// Multiplies the raw loss `mean_i ‖d_i‖²` and its gradient.
+    /// 1 is the raw loss; the default [`DEFAULT_PLANAR_SCALE`] makes the planar gradient
     /// comparable to the render gradient at weight 1. The raw and render gradients both scale
     /// like 1/#V per vertex, so a constant factor keeps the balance across resolutions.
     pub scale: f64,
@@ -100,7 +105,7 @@ impl Default for PlanarOptions {
 }
 
 impl PlanarOptions {
-    /// The spec's raw loss (`scale = 1`, mean over samples), other options default.
+    /// The raw loss (`scale = 1`, mean over samples), other options default.
     pub fn raw() -> Self {
         Self {
             scale: 1.0,
@@ -126,7 +131,7 @@ pub struct PlanarStats {
     pub max_move: f64,
 }
 
-/// The planar projection loss against a fixed oriented point cloud (spec §3.2.2).
+/// The planar projection loss against a fixed oriented point cloud.
 pub struct PlanarLoss {
     projector: KnnPlanarProjector,
     options: PlanarOptions,
@@ -205,8 +210,8 @@ impl PlanarLoss {
         (combine_moves(&s2t, &t2s), from_t2s)
     }
 
-    /// The regular samples of this evaluation under the cap (spec §3.3, normals blended from
-    /// the source's ROAR vertex normals, spec §2.2); advances the RNG.
+    /// The regular samples of this evaluation under the cap (normals blended from
+    /// the source's ROAR vertex normals); advances the RNG.
     fn draw_samples(&mut self, positions: &[DVec3], triangles: &[[u32; 3]]) -> CappedSamples {
         let normals = vertex_normals(positions, triangles);
         capped_regular_samples(
@@ -272,8 +277,8 @@ fn len2(d: Option<DVec3>) -> f64 {
     d.map_or(0.0, |d| d.length_squared())
 }
 
-/// Per sample, the move with the larger magnitude of the two terms (spec §3.2.2
-/// "Combination"); ties and equal magnitudes keep s2t. `None` only when both are `None`.
+/// Per sample, the move with the larger magnitude of the two terms; ties and equal magnitudes keep
+/// s2t. `None` only when both are `None`.
 pub fn combine_moves(s2t: &[Option<DVec3>], t2s: &[Option<DVec3>]) -> Vec<Option<DVec3>> {
     s2t.iter()
         .enumerate()
@@ -288,7 +293,7 @@ pub fn combine_moves(s2t: &[Option<DVec3>], t2s: &[Option<DVec3>]) -> Vec<Option
         .collect()
 }
 
-/// The target→source term (spec §3.2.2 t2s): every target point is assigned to its nearest
+/// The target→source term: every target point is assigned to its nearest
 /// sample (f32 kd-tree over the samples, ties to the smaller sample index; the assigned
 /// distance is recomputed in f64); each sample takes its farthest assigned point `t*` (ties: smaller target index) and,
 /// if `m_{t*}·n_i ≥ normal_dot`, the along-normal intersection with the plane `(t*, m_{t*})`.
@@ -469,7 +474,7 @@ fn corner_positions(positions: &[DVec3], tri: &[u32; 3]) -> Option<[DVec3; 3]> {
     ])
 }
 
-/// Indices of the samples kept under `cap` (spec: at most `cap` samples per evaluation).
+/// Indices of the samples kept under `cap` (at most `cap` samples per evaluation).
 ///
 /// All samples when there are at most `cap`. Otherwise each face keeps a share `p = cap/total`
 /// of its own samples, stratified: `k_f = ⌊p·m_f + u⌋` (u uniform, one draw per face, so the
@@ -604,7 +609,7 @@ fn capped_regular_samples(
 }
 
 /// Bounding-box diagonal of the vertices referenced by `triangles` (0 when there are none), the
-/// D of the sampling density (spec §3.3).
+/// D of the sampling density.
 fn referenced_bbox_diagonal(positions: &[DVec3], triangles: &[[u32; 3]]) -> f64 {
     let mut lo = DVec3::splat(f64::INFINITY);
     let mut hi = DVec3::splat(f64::NEG_INFINITY);

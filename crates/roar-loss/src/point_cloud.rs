@@ -1,5 +1,5 @@
-//! The oriented target point cloud P (spec §3.1 (b)): area-weighted samples of T′ with their
-//! face normals, kept only where they face open space.
+//! The oriented target point cloud P (`docs/method.md#point-cloud`): area-weighted samples of T′
+//! with their face normals, kept only where they face open space.
 //!
 //! A sample `p` with normal `n` is kept when the generalized winding number of T′ at
 //! `p + offset·n` is small in magnitude (`|w| < 0.2`): a point just off an outward surface is
@@ -43,22 +43,22 @@ impl PointCloud {
         self.points.is_empty()
     }
 
-    /// Appends the points of `other` (spec §3.1 (c): sharp-edge samples are added to P).
+    /// Appends the points of `other` (the sharp-edge samples join P this way).
     pub fn extend(&mut self, other: PointCloud) {
         self.points.extend(other.points);
         self.normals.extend(other.normals);
     }
 }
 
-/// Options of [`point_cloud`] (spec §3.1 (b)).
+/// Options of [`point_cloud`].
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct PointCloudOptions {
-    /// Samples drawn before filtering (spec: N_pc = 200 000).
+    /// Samples drawn before filtering (supplementary §1.2: up to 200 000).
     pub samples: usize,
-    /// The winding number is read at `p + winding_offset·n` (spec: 1e-3, rig units).
+    /// The winding number is read at `p + winding_offset·n` (the authors' code: 1e-3, rig units).
     pub winding_offset: f64,
-    /// Samples with `|w| ≥ winding_threshold` are dropped (spec: τ_wn = 0.2; configs also use
-    /// 0.48–0.49, OQ-14).
+    /// Samples with `|w| ≥ winding_threshold` are dropped (default 0.2, as the authors' code;
+    /// `docs/method.md#decision-winding-threshold-of-the-point-cloud`).
     pub winding_threshold: f64,
     /// Samples on two-sided faces ([`two_sided_faces`]) are moved this far along their normal
     /// (rig units; 0 = the paper's cloud). See the module docs.
@@ -79,7 +79,7 @@ impl Default for PointCloudOptions {
     }
 }
 
-/// The oriented point cloud P of a target (spec §3.1 (b)); see [`point_cloud_of_soup`].
+/// The oriented point cloud P of a target; see [`point_cloud_of_soup`].
 pub fn point_cloud(target: &Target, options: &PointCloudOptions) -> Result<PointCloud, LossError> {
     point_cloud_of_soup(&target.positions, &target.triangles, options)
 }
@@ -129,7 +129,7 @@ pub fn point_cloud_of_soup(
 
 /// For each face of a soup, whether its reversed twin (the same three vertex indices in the
 /// other orientation) is in the soup too: the face is then one side of a zero-thickness sheet.
-/// In T′ these are the undecided pairs of the twin rule (spec §3.1 (a) step 4), since the
+/// In T′ these are the undecided pairs of the twin rule, since the
 /// exact duplicates are gone before the twins are added.
 pub fn two_sided_faces(triangles: &[[u32; 3]]) -> Vec<bool> {
     // A face and its twin are the same cyclic sequence read backwards; key both by the

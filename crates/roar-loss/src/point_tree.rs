@@ -1,5 +1,5 @@
 //! A static kd-tree over 3-D points for k-nearest and nearest-one queries, with f32 coordinates
-//! and allocation-free queries (the hot loop of the planar loss, spec §3.2.2).
+//! and allocation-free queries (the hot loop of the planar loss).
 //!
 //! Geometry is normalized into a sphere of radius about 1, where f32 (relative precision 6e-8)
 //! finds the same neighbours as f64 except for near-ties; callers that need exact distances

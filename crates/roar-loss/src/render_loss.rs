@@ -1,5 +1,6 @@
-//! The render loss `L_render` (spec §3.2.1): mean over views, pixels and RGBA channels of
-//! `|I_src − I_tgt|` between flat-shaded normal maps of the source mesh and of the target.
+//! The render loss `L_render` (`docs/method.md#render-loss`): mean over views, pixels and RGBA
+//! channels of `|I_src − I_tgt|` between flat-shaded normal maps of the source mesh and of the
+//! target.
 //!
 //! The source is rendered **without** back-face culling, so a fold of the source (a face seen
 //! from behind) shows its reversed normal and is penalized; the target renders come from
@@ -15,13 +16,14 @@ use crate::{Loss, LossError};
 /// The render loss against fixed target images, one per camera.
 #[derive(Clone, Debug)]
 pub struct RenderLoss {
-    /// The rig (spec §3.2.1: the 6×6 star rig at 512²).
+    /// The rig (the paper's is the 6×6 star rig at 512²).
     pub cameras: Vec<Camera>,
     /// One target image per camera, same resolution.
     pub targets: Vec<Image>,
-    /// How the source is rendered: culling off, antialiasing on (spec §3.2.1).
+    /// How the source is rendered: culling off, so folds show their reversed
+    /// normal, and antialiasing on, for silhouette gradients.
     pub options: RenderOptions,
-    /// The per-channel penalty (spec §3.2.1: L1).
+    /// The per-channel penalty (L1, as in Continuous Remeshing).
     pub kind: LossKind,
     /// A coarser rig for the loop's first iterations (none: `cameras` throughout).
     pub coarse: Option<CoarseViews>,

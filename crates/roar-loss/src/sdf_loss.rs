@@ -1,11 +1,11 @@
-//! The SDF projection loss of spec §5: each vertex pulled toward its first-order projection
-//! onto the zero set of the target's signed distance.
+//! The SDF projection loss (supplementary §3; `docs/method.md#sdf-loss`): each vertex pulled toward
+//! its first-order projection onto the zero set of the target's signed distance.
 //!
 //! Over the mesh's vertices v: `p = v − f(v) ∇f(v)/(|∇f(v)|² + ε)`, held constant (no gradient
 //! through p), and `L = mean_v ‖v − p‖` (unsquared), whose gradient per vertex is the unit
 //! vector `(v − p)/‖v − p‖` divided by the vertex count. `‖v − p‖` is the first-order distance
 //! `|f|/|∇f|`, so the loss treats a true distance and a field of any other scale alike. The
-//! reference divides by `|∇f| + 1e-5`, the same for a true distance.
+//! authors' code divides by `|∇f| + 1e-5`, the same for a true distance.
 
 use std::sync::Arc;
 
@@ -18,7 +18,7 @@ use crate::{Loss, LossError};
 #[derive(Clone, Debug, PartialEq)]
 pub struct SdfLossOptions {
     /// The loss is zero (and the field not evaluated) before this iteration of the loop
-    /// (spec §5: on from iteration 500).
+    /// (supplementary §3: on from iteration 500).
     pub start_iteration: usize,
     /// `ε` of the projection's denominator `|∇f|² + ε`.
     pub epsilon: f64,
@@ -33,7 +33,7 @@ impl Default for SdfLossOptions {
     }
 }
 
-/// `L_sdf` of spec §5 ([module docs](self)), on a field in rig coordinates.
+/// `L_sdf` ([module docs](self)), on a field in rig coordinates.
 pub struct SdfLoss {
     sdf: Arc<dyn Sdf>,
     options: SdfLossOptions,

@@ -1,4 +1,4 @@
-//! Sharp-edge densification of the target point cloud (spec §3.1 (c)).
+//! Sharp-edge densification of the target point cloud (supplementary §2).
 //!
 //! Soup edges are unreliable, so sharp features are found on the initial closed mesh M0: an
 //! edge is *sharp* when the unit normals of its two faces satisfy `|n_L·n_R| < cos_threshold`
@@ -17,15 +17,16 @@ use roar_mesh::spatial::TriangleBvh;
 use crate::LossError;
 use crate::point_cloud::PointCloud;
 
-/// Options of [`sharp_edge_samples`] (spec §3.1 (c)).
+/// Options of [`sharp_edge_samples`].
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SharpEdgeOptions {
-    /// Points drawn on the sharp edges (spec: 30 000).
+    /// Points drawn on the sharp edges (supplementary §2: 30 000).
     pub samples: usize,
-    /// An edge is sharp when `|n_L·n_R|` is below this (spec [SUP]: 0.5).
+    /// An edge is sharp when `|n_L·n_R|` is below this (supplementary §2: 0.5; the authors' code
+    /// uses an angle of 0.5 rad instead, `docs/method.md#decision-sharp-edge-criterion`).
     pub cos_threshold: f64,
     /// The target normal is flipped when its dot with M0's reference normal is below this
-    /// (spec: 1e-5).
+    /// (the authors' code: 1e-5).
     pub flip_threshold: f64,
     /// A sample on a two-sided target face is moved this far along its normal (rig units;
     /// 0 = off), as in [`crate::PointCloudOptions::sheet_offset`].
@@ -107,7 +108,7 @@ pub fn sharp_edges(
     Ok(edges)
 }
 
-/// Points on M0's sharp edges, moved onto T′ with oriented target normals (spec §3.1 (c)).
+/// Points on M0's sharp edges, moved onto T′ with oriented target normals.
 ///
 /// Inputs: `target` a BVH over T′ (rig coordinates), `m0_positions`/`m0_triangles` the initial
 /// closed mesh in the same coordinates. Output: `options.samples` points (none if M0 has no

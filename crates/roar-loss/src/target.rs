@@ -1,6 +1,6 @@
 //! The reconstruction target T′: a triangle soup cleaned of duplicates, degenerate faces and
-//! inward-facing sheets, normalized into the rig's sphere, with its 36 reference renders
-//! (spec §3.1 (a) and (d), DESIGN.md §2 "target soup ──roar-loss──▶ T′").
+//! inward-facing sheets, normalized into the rig's sphere, with one reference render per view
+//! (`docs/method.md#target-clean-up-and-renders`).
 //!
 //! The data walk of [`build_target`]:
 //! 1. weld bit-identical positions (−0.0 counts as 0.0);
@@ -30,13 +30,13 @@ const VIEW_CHUNK: usize = 4;
 /// Options of [`build_target`].
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct TargetOptions {
-    /// Cameras per rig axis: the star rig has `views_per_axis²` views (spec §3.2.1: 6 → 36).
+    /// Cameras per rig axis: the star rig has `views_per_axis²` views (the paper's 6 → 36).
     pub views_per_axis: usize,
     /// Square render resolution in pixels, for the twin counts and the target renders
-    /// (spec §3.1 (a) step 3 and §3.2.1: 512).
+    /// (supplementary §1.2: 512).
     pub resolution: u32,
     /// A twin is dropped only when its partner has at least `twin_ratio × (its count + 1)`
-    /// visible pixels (spec §3.1 (a) step 4: 80).
+    /// visible pixels (supplementary §1.2: 80).
     pub twin_ratio: f64,
 }
 
@@ -97,13 +97,13 @@ pub struct Target {
 }
 
 impl Target {
-    /// A BVH over T′ (closest point and ray queries, spec §3.1 (e)).
+    /// A BVH over T′ (closest point and ray queries).
     pub fn bvh(&self) -> TriangleBvh {
         TriangleBvh::build(&self.positions, &self.triangles)
     }
 }
 
-/// Builds the target T′ from a triangle soup (spec §3.1 (a), (d); module docs list the steps).
+/// Builds the target T′ from a triangle soup (the module docs list the steps).
 ///
 /// Inputs: `positions` (#V, any coordinates), `triangles` (#F indices into `positions`).
 /// Errors: an index out of range, a non-finite coordinate on a referenced vertex, no face with
@@ -244,7 +244,8 @@ fn is_degenerate(positions: &[DVec3], t: [u32; 3]) -> bool {
     (b - a).cross(c - a) == DVec3::ZERO
 }
 
-/// Keeps the first face of every vertex set (spec §3.1 (a) step 1: orientation ignored).
+/// Keeps the first face of every vertex set (orientation ignored, so a face and its
+/// reversed copy count as duplicates).
 fn remove_duplicate_faces(faces: &[[u32; 3]]) -> Vec<[u32; 3]> {
     let mut seen = std::collections::HashSet::with_capacity(faces.len());
     faces
@@ -259,7 +260,7 @@ fn remove_duplicate_faces(faces: &[[u32; 3]]) -> Vec<[u32; 3]> {
 }
 
 /// Visible pixels per face of the doubled soup `faces ++ reversed(faces)`, summed over the rig's
-/// views with back-face culling (spec §3.1 (a) steps 2–3). Entry `f` is face `f`, entry
+/// views with back-face culling. Entry `f` is face `f`, entry
 /// `F + f` its twin.
 fn twin_pixel_counts(
     positions: &[DVec3],
@@ -286,7 +287,8 @@ fn twin_pixel_counts(
     Ok(counts)
 }
 
-/// Applies spec §3.1 (a) step 4 and returns the kept faces, pair by pair (face, then twin).
+/// Applies the twin rule (a twin goes only when its partner has `twin_ratio` times more
+/// pixels) and returns the kept faces, pair by pair (face, then twin).
 fn choose_twins(
     faces: &[[u32; 3]],
     counts: &[u64],

@@ -1,4 +1,4 @@
-//! The render loss of spec §3.2.1 as a [`Loss`]: finite differences within a visibility cell,
+//! The render loss as a [`Loss`]: finite differences within a visibility cell,
 //! zero against itself, descent under small gradient steps.
 
 mod common;

@@ -1,5 +1,5 @@
-//! The soup clean-up of spec §3.1 (a): welding, degenerate and duplicate faces, twin choice by
-//! pixel counts, unreferenced vertices, normalization.
+//! The soup clean-up that makes the target T′: welding, degenerate and duplicate faces, twin choice
+//! by pixel counts, unreferenced vertices, normalization.
 
 mod common;
 

@@ -1,4 +1,4 @@
-//! The oriented point cloud P (spec §3.1 (b)) and the sharp-edge samples (spec §3.1 (c)).
+//! The oriented point cloud P and the sharp-edge samples.
 
 mod common;
 

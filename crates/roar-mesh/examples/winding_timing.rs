@@ -1,8 +1,8 @@
-//! Timing and accuracy of the fast winding number: 200k queries on a subdivided icosphere
-//! (level 6 = 81,920 triangles by default; `cargo run --release -p roar-mesh --example
-//! winding_timing -- [levels] [queries] [beta] [leaf_size]`). Prints build time, query time for uniform
-//! points in the bounding box and for points near the surface (the spec's `p + 1e-3·n` use),
-//! and fast-vs-exact error statistics on a subset.
+//! Timing and accuracy of the fast winding number: 200k queries on a subdivided icosphere (level 6,
+//! 81,920 triangles, by default; `cargo run --release -p roar-mesh --example winding_timing --
+//! [levels] [queries] [beta] [leaf_size]`). Prints build time, query time for uniform points in the
+//! bounding box and for points near the surface (the point cloud filter's `p + 1e-3·n`), and
+//! fast-vs-exact error statistics on a subset.
 
 use glam::DVec3;
 use rand::{Rng, SeedableRng};

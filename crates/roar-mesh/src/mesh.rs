@@ -6,10 +6,11 @@ use glam::DVec3;
 /// Raw-array sentinel for "no element"; never exposed by the public API.
 pub(crate) const INVALID: u32 = u32::MAX;
 
-/// Faces with `|cross| <= DEGENERATE_CROSS` get the default normal and clamped area (spec §2.2).
+/// Faces with `|cross| <= DEGENERATE_CROSS` get the default normal and clamped area, so no normal
+/// or area is NaN (as in the authors' code; `docs/method.md#conventions`).
 pub const DEGENERATE_CROSS: f64 = 1e-9;
 
-/// Normal of a degenerate face (spec §2.2).
+/// Normal of a degenerate face.
 pub const DEGENERATE_NORMAL: DVec3 = DVec3::X;
 
 /// A closed, oriented, 2-manifold triangle mesh in half-edge form.
@@ -260,13 +261,13 @@ impl Mesh {
         (b - a).cross(c - a)
     }
 
-    /// Unit normal of `f`; faces with `|cross| <= 1e-9` get `(1, 0, 0)` (spec §2.2).
+    /// Unit normal of `f`; faces with `|cross| <= 1e-9` get `(1, 0, 0)`.
     pub fn face_normal(&self, f: FaceId) -> DVec3 {
         let [a, b, c] = self.face_vertices(f).map(|v| self.position(v));
         crate::spatial::triangle_normal(a, b, c)
     }
 
-    /// Area of `f`, clamped below at `1e-9` as in spec §2.2.
+    /// Area of `f`, clamped below at `1e-9` so that no ratio of areas is NaN.
     pub fn face_area(&self, f: FaceId) -> f64 {
         (0.5 * self.face_cross(f).length()).max(DEGENERATE_CROSS)
     }

@@ -1,4 +1,4 @@
-//! Behaviour of the regular (MESH-style) face supersampling of spec §3.3.
+//! Behaviour of the regular (MESH-style) face supersampling.
 
 use glam::DVec3;
 use proptest::prelude::*;
@@ -92,7 +92,7 @@ fn cap_and_minimum_are_respected() {
     assert_eq!(
         s.face_samples(0).len(),
         406,
-        "the [SUP] 420 reading: n ≤ 28"
+        "the supplementary's 420 samples: n ≤ 28"
     );
 }
 

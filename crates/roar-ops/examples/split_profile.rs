@@ -1,4 +1,4 @@
-//! Profiling driver for the Face Split block (spec §3.8): one or more `face_split` calls on the
+//! Profiling driver for the Face Split block: one or more `face_split` calls on the
 //! ~10k-face UV sphere of the `blocks` bench against the analytic sphere projector, with a
 //! coarse per-phase wall-clock breakdown. Meant for `valgrind --tool=callgrind` (repeatable
 //! instruction counts on a noisy machine):

@@ -1,7 +1,7 @@
-//! Per-block geometry snapshots on the half-edge mesh (spec §2.2): face normals and areas, ROAR
-//! vertex normals (the area × corner-angle weights of `roar_mesh::spatial`), the normal
-//! magnitude μ_v and face folds φ_f. Computed once per block call into `Vec`s indexed by element id (slot),
-//! dead slots hold zeros.
+//! Per-block geometry snapshots on the half-edge mesh (`docs/method.md#conventions`): face normals
+//! and areas, ROAR vertex normals (the area × corner-angle weights of `roar_mesh::spatial`), the
+//! normal magnitude μ_v and face folds φ_f. Computed once per block call into `Vec`s indexed by
+//! element id (slot), dead slots hold zeros.
 
 use roar_mesh::spatial::area_angle_weights;
 use roar_mesh::{DEGENERATE_CROSS, DVec3, EdgeId, Mesh, VertexId};
@@ -38,7 +38,7 @@ pub fn flip_keeps_orientation([pa, pb, pc, pd]: [DVec3; 4]) -> bool {
     n_old.dot((pd - pa).cross(pc - pa)) > 0.0 && n_old.dot((pc - pb).cross(pd - pb)) > 0.0
 }
 
-/// Geometry of one mesh state, indexed by slot id (spec §2.2).
+/// Geometry of one mesh state, indexed by slot id.
 #[derive(Debug, Clone, Default)]
 pub struct Geometry {
     /// Unit face normals (degenerate faces: `(1, 0, 0)`), by face slot.
@@ -96,7 +96,7 @@ impl Geometry {
         self.vertex_normals[v.index()]
     }
 
-    /// Face folds `φ_f = 1 − (1/3) Σ_k n_f · n_{v_k}` by face slot (spec §2.2): 0 on smooth
+    /// Face folds `φ_f = 1 − (1/3) Σ_k n_f · n_{v_k}` by face slot: 0 on smooth
     /// surfaces, above 1 when a face points against its own vertex normals.
     pub fn face_folds(&self, mesh: &Mesh) -> Vec<f64> {
         let mut folds = vec![0.0; mesh.face_capacity()];

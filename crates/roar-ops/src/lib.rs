@@ -1,7 +1,7 @@
 //! # roar-ops
 //!
 //! The mesh algorithms of the reconstruction, one folder per stage of the pipeline, listed here
-//! in the order the pipeline runs them (DESIGN.md §2):
+//! in the order the pipeline runs them (`docs/design.md#one-reconstruction`):
 //!
 //! | stage | module | what |
 //! |---|---|---|

@@ -134,8 +134,8 @@ fn coarse_icosphere_faces_score_on_a_sphere() {
         s.iter().all(|&x| x > 0.02),
         "every face lies over curved target: {s:?}"
     );
-    // Default (0.02 per sub-triangle, note 1): a smooth unit sphere bends far less than 0.02
-    // per sub-triangle at the sampling density, so nothing scores.
+    // Default (0.02 per sub-triangle, as the authors' scoring code): a smooth unit sphere bends far
+    // less than 0.02 per sub-triangle at the sampling density, so nothing scores.
     let s = scores(&mesh, &FaceSplitOptions::default());
     assert!(s.iter().all(|&x| x == 0.0));
 }
@@ -316,7 +316,7 @@ fn crease_detection(level: u32, options: &FaceSplitOptions) -> f64 {
 #[test]
 fn default_threshold_sees_creases_from_about_35_degrees_and_the_per_face_rule_gentler_ones() {
     // Polyhedra over icosphere(0|1|2) vertex directions bend by about 63°/36°/16° at their
-    // edges. Flat faces score 0 under both rules (asserted inside). Note 1's 0.02 per
+    // edges. Flat faces score 0 under both rules (asserted inside). The default 0.02 per
     // sub-triangle needs a sub-triangle to bend by roughly 25–30°: it scores every face
     // across a 63° or 36° crease but only part of those across 16° creases (the ones near
     // polyhedron vertices, where chords across three planes tilt more); the per-face rule sums

@@ -1,5 +1,6 @@
-//! QSlim cost (spec §3.10, note 5): free in flat regions for the normalized vertex plane,
-//! Laplacian-driven for the code's raw variant, positive across a crease.
+//! QSlim cost (`docs/method.md#decision-vertex-plane-of-the-collapse-cost`): free in flat regions
+//! for the normalized vertex plane, Laplacian-driven for the code's raw variant, positive across a
+//! crease.
 
 use roar_mesh::shapes::genus_n_solid;
 use roar_mesh::{DVec3, EdgeId, Mesh};

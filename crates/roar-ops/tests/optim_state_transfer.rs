@@ -1,4 +1,4 @@
-//! Optimizer rows follow the vertices through topology changes (spec §3.12).
+//! Optimizer rows follow the vertices through topology changes.
 
 mod optim_common;
 

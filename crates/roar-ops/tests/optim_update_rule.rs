@@ -1,4 +1,5 @@
-//! The optimizer step follows spec §3.2.4 exactly, and it descends.
+//! The optimizer step follows the authors' update rule exactly (`docs/method.md#optimizer`), and
+//! it descends.
 
 mod optim_common;
 
@@ -175,7 +176,7 @@ fn a_component_whose_first_gradient_was_zero_still_moves_later() {
 #[test]
 fn reference_clamping_freezes_a_component_whose_first_gradient_was_zero() {
     let (dy, clamped) = y_motion_after_a_late_nonzero_component(false);
-    assert_eq!(dy, 0.0, "switch off: the y component stays frozen (note 6)");
+    assert_eq!(dy, 0.0, "authors' clamp: the y component stays frozen");
     assert_eq!(
         clamped,
         6 * 5,
@@ -248,8 +249,8 @@ fn without_laplacian_weight_a_tangential_loss_leaves_the_bump() {
 
 #[test]
 fn reference_clamping_also_blocks_the_laplacian_term() {
-    // The Laplacian's z component is 0 at t = 1 (ν starts at 0), so the reference clamp
-    // freezes it: another face of verification note 6.
+    // The Laplacian's z component is 0 at t = 1 (ν starts at 0), so the authors' clamp
+    // freezes it: another reason to clamp only where m1 ≠ 0.
     let options = OptimizerOptions {
         clamp_only_nonzero_m1: false,
         ..Default::default()

@@ -1,4 +1,6 @@
-//! Cameras and the star rig of spec §3.2.1, and the world → pixel projection with its Jacobian.
+//! Cameras and the star rig of Continuous Remeshing that the authors' code renders with
+//! (`docs/method.md#target-clean-up-and-renders`), and the world → pixel projection with its
+//! Jacobian.
 //!
 //! Pixel coordinates: x grows to the right, y grows downwards (row 0 is the top row, because the
 //! projection flips y); pixel `(i, j)` covers `[i, i+1) × [j, j+1)` and is sampled at its centre
@@ -6,11 +8,11 @@
 
 use glam::{DMat3, DMat4, DVec3, DVec4};
 
-/// Distance of the rig's cameras from the origin (spec §3.2.1).
+/// Distance of the rig's cameras from the origin.
 pub const CAMERA_DISTANCE: f64 = 10.0;
-/// Near plane distance of the rig's frustum (spec §3.2.1).
+/// Near plane distance of the rig's frustum.
 pub const NEAR: f64 = 1.0;
-/// Far plane distance of the rig's frustum (spec §3.2.1).
+/// Far plane distance of the rig's frustum.
 pub const FAR: f64 = 50.0;
 
 /// A pinhole camera: OpenGL-style view and projection matrices and an image size.
@@ -118,7 +120,8 @@ pub fn project_backward(
 }
 
 /// The rig's perspective frustum: near 1, far 50, symmetric half-extent `1/distance` at the
-/// near plane, y flipped (spec §3.2.1).
+/// near plane (nearly orthographic: a sphere of radius 1 at the origin just fills the frame),
+/// y flipped.
 pub fn star_projection() -> DMat4 {
     let r = 1.0 / CAMERA_DISTANCE;
     let (n, f) = (NEAR, FAR);
@@ -130,7 +133,7 @@ pub fn star_projection() -> DMat4 {
     )
 }
 
-/// The star rig of spec §3.2.1: `n_az × n_pol` cameras (the spec's 6 × 6 = 36), index
+/// The star rig: `n_az × n_pol` cameras (the paper's 6 × 6 = 36), index
 /// `a · n_pol + p`, with azimuth `φ_a = a·2π/n_az` about world y, polar angle
 /// `θ_p = (p+1)·π/(n_pol+1) − π/2` about x, view `T(0,0,−10)·R_x(θ_p)·R_y(φ_a)`, and the
 /// frustum of [`star_projection`].

@@ -1,7 +1,7 @@
 //! # roar-render
 //!
-//! The CPU differentiable rasterizer of roar (spec `roar-method.md` §3.2.1,
-//! `crates-and-rendering.md` §3.4): the star camera rig, z-buffered rasterization of flat-shaded
+//! The CPU differentiable rasterizer of roar, for the render loss
+//! (`docs/method.md#render-loss`): the star camera rig, z-buffered rasterization of flat-shaded
 //! normal maps with alpha, analytic antialiasing in the manner of Laine et al. 2020 (nvdiffrast),
 //! and the backward pass from image gradients to vertex positions.
 //!
@@ -44,11 +44,11 @@ pub const BACKGROUND: u32 = u32::MAX;
 /// Options of the rasterizer.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct RenderOptions {
-    /// Skip triangles that face away from the camera. Off by default: the render loss of
-    /// spec §3.2.1 (like Continuous Remeshing) renders both sides; the soup orientation
-    /// clean-up of spec §3.1(a) step 3 turns it on.
+    /// Skip triangles that face away from the camera. Off by default: the render loss
+    /// (like Continuous Remeshing) renders both sides, so a fold shows its reversed normal; the
+    /// soup orientation clean-up, which counts each twin's visible pixels, turns it on.
     pub cull_backfaces: bool,
-    /// Analytic antialiasing (spec §3.2.1 "Antialiasing"); the only source of silhouette and
+    /// Analytic antialiasing; the only source of silhouette and
     /// occlusion gradients. On by default.
     pub antialias: bool,
 }

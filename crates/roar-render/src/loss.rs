@@ -1,4 +1,4 @@
-//! Image losses of spec §3.2.1: the mean over views × pixels × 4 channels of `|I − T|` (L1, the
+//! Image losses of the render loss: the mean over views × pixels × 4 channels of `|I − T|` (L1, the
 //! paper's) or `(I − T)²` (L2), and their gradients with respect to the rendered image.
 
 use crate::{Image, RenderError, Renders};
@@ -9,8 +9,8 @@ pub type ImageGrad = Vec<Vec<[f64; 4]>>;
 /// Which per-channel penalty the image loss uses.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum LossKind {
-    /// `|I − T|`, subgradient `sign(I − T)` with `sign(0) = 0` (spec §3.2.1, as in Continuous
-    /// Remeshing). The default.
+    /// `|I − T|`, subgradient `sign(I − T)` with `sign(0) = 0` (as in Continuous Remeshing).
+    /// The default.
     #[default]
     L1,
     /// `(I − T)²`, gradient `2 (I − T)`.

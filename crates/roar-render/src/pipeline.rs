@@ -603,7 +603,8 @@ fn view_loss_and_grad(
 }
 
 /// Number of pixels, over all views, in which each face is the visible triangle (before
-/// antialiasing). Used by the soup orientation clean-up (spec §3.1(a) step 3) with culling on.
+/// antialiasing). Used by the soup orientation clean-up, which keeps the twin of a face that
+/// collects more pixels, with culling on.
 pub fn face_pixel_counts(renders: &Renders) -> Vec<u32> {
     let mut counts = vec![0u32; renders.num_faces];
     for view in &renders.views {

@@ -1,13 +1,13 @@
 //! # roar-sdf
 //!
-//! Signed distance functions as inputs of roar (spec §5): readers for the kinds of field
-//! (an analytic `.sdf.toml` [`AnalyticSdf`], a neural MLP [`Mlp`] from a sequential `.npz` or an
-//! IDR/VolSDF/NeuS `.safetensors` state dict ([`implicit_network`]), a dense `.npy` grid
-//! [`GridSdf`]), all behind
-//! `roar_mesh::spatial::Sdf`, and what the pipeline needs from a field: its normal maps by
-//! grid-bracketed tracing ([`trace`]), the Face Split projector and the projection of samples
-//! onto the zero set ([`project`]), the field in rig coordinates ([`RigSdf`]), and the marching
-//! baseline that samples a field on a grid and extracts its zero set ([`extract`]).
+//! Signed distance functions as inputs of roar (supplementary §3; `docs/sdf.md`): readers for the
+//! kinds of field (an analytic `.sdf.toml` [`AnalyticSdf`], a neural MLP [`Mlp`] from a sequential
+//! `.npz` or an IDR/VolSDF/NeuS `.safetensors` state dict ([`implicit_network`]), a dense `.npy`
+//! grid [`GridSdf`]), all behind `roar_mesh::spatial::Sdf`, and what the pipeline needs from a
+//! field: its normal maps by grid-bracketed tracing ([`trace`]), the Face Split projector and the
+//! projection of samples onto the zero set ([`project`]), the field in rig coordinates
+//! ([`RigSdf`]), and the marching baseline that samples a field on a grid and extracts its zero set
+//! ([`extract`]).
 
 pub mod analytic;
 pub mod extract;

@@ -1,18 +1,19 @@
-//! Projections onto an SDF's zero set: the Face Split block's projector (spec §3.4 C) and the
-//! oriented point cloud of samples pulled onto the surface.
+//! Projections onto an SDF's zero set: the Face Split block's projector (the authors' code's for
+//! fields, `docs/method.md#projection-onto-the-target`) and the oriented point cloud of samples
+//! pulled onto the surface.
 
 use std::sync::Arc;
 
 use glam::DVec3;
 use roar_mesh::spatial::{Projector, Sdf, evaluate_with_gradients, project_to_zero_set};
 
-/// Options of [`SdfProjector`] (spec §3.4 C).
+/// Options of [`SdfProjector`].
 #[derive(Clone, Debug, PartialEq)]
 pub struct SdfProjectorOptions {
-    /// Steps `x ← x + n (n · d)`, `d = −f ∇f/|∇f|²` (the reference: 5).
+    /// Steps `x ← x + n (n · d)`, `d = −f ∇f/|∇f|²` (the authors' code: 5).
     pub steps: usize,
-    /// A sample fails when its first-order distance `|f|/|∇f|` ends above this (the reference:
-    /// 1e-6 for a float64 field; f32 networks need more).
+    /// A sample fails when its first-order distance `|f|/|∇f|` ends above this (the authors'
+    /// code: 1e-6 for a float64 field; f32 networks need more).
     pub tolerance: f64,
 }
 
@@ -25,12 +26,11 @@ impl Default for SdfProjectorOptions {
     }
 }
 
-/// The Face Split projector of an SDF (spec §3.4 C): each sample moves along its own normal
-/// by first-order steps toward the zero set, the moving samples in one batch per step, and
-/// stops as soon as its first-order distance `|f|/|∇f|` is within the tolerance (the
-/// reference takes every step; later ones would move it by less than the tolerance). A sample
-/// is invalid when `|f|` grew, its distance ended above the tolerance, or a value is not finite.
-/// Ignores the source mesh.
+/// The Face Split projector of an SDF: each sample moves along its own normal by first-order steps
+/// toward the zero set, the moving samples in one batch per step, and stops as soon as its
+/// first-order distance `|f|/|∇f|` is within the tolerance (the authors' code takes every step;
+/// later ones would move it by less than the tolerance). A sample is invalid when `|f|` grew, its
+/// distance ended above the tolerance, or a value is not finite. Ignores the source mesh.
 pub struct SdfProjector {
     /// The field, in the coordinates of the samples.
     pub sdf: Arc<dyn Sdf>,

@@ -1,7 +1,7 @@
 //! Which blocks of the loop create self-intersections: runs the pipeline on a mesh file with
 //! every default block wrapped in a counter of intersecting faces before and after it, and
 //! prints, per block, how often it raised the count and by how much in total.
-//! `cargo run --release -p roar-cli --example block_intersections -- FILE [FACES] [RESOLUTION]`.
+//! `cargo run --release -p roar --example block_intersections -- FILE [FACES] [RESOLUTION]`.
 //! Diagnostic only: the exact all-pairs check after every block makes the run much slower.
 
 use roar::{InitConfig, ReconstructConfig, Reconstruction, ScheduledBlock};

@@ -2,7 +2,7 @@
 //! own target renders, oriented point cloud and initial mesh through the [`Shape`] seam, at toy
 //! settings so it runs in seconds.
 //!
-//! `cargo run --release -p roar-cli --example custom_shape [OUTPUT.obj]` (default
+//! `cargo run --release -p roar --example custom_shape [OUTPUT.obj]` (default
 //! `target/custom_shape.obj`) writes the reconstruction in the torus's own coordinates and
 //! prints how far its vertices are from the torus.
 

@@ -2,7 +2,7 @@
 //! paper's render and planar terms plus a term of your own) and a swapped block (a block of
 //! your own in the schedule), at toy settings so it runs in seconds.
 //!
-//! `cargo run --release -p roar-cli --example library [OUTPUT.obj]` (default
+//! `cargo run --release -p roar --example library [OUTPUT.obj]` (default
 //! `target/library.obj`) writes the reconstruction and prints what the run did.
 
 use std::path::PathBuf;
@@ -54,7 +54,7 @@ impl Loss for EdgeLength {
     }
 }
 
-/// A block of our own: the valence-improving edge flips of spec §3.7 on their own schedule. A
+/// A block of our own: the valence-improving edge flips on their own schedule. A
 /// [`Block`] edits the mesh through a [`TrackedMesh`]; flips keep the vertex set, so they go
 /// through `with_fixed_vertices` (an operator that adds or removes vertices would call the
 /// tracked mesh's own methods, which keep the optimizer's per-vertex rows in step).

@@ -1,8 +1,9 @@
-//! Gradient balance of the objective's terms on a real mesh and its init (Verification note 2):
+//! Gradient balance of the objective's terms on a real mesh and its init, which chose
+//! the pipeline's `planar_scale` (`docs/method.md#decision-balance-of-the-planar-term`):
 //! mean per-vertex gradient norm of λ1·render, of the planar term (raw and at its default scale),
 //! and of the optimizer's Laplacian term `w_lap·ν·δ_v` (with ν = 1, its value after a first step).
 //!
-//! `cargo run --release -p roar-cli --example loss_balance -- MESH [FACES]`
+//! `cargo run --release -p roar --example loss_balance -- MESH [FACES]`
 
 use glam::DVec3;
 use roar::ReconstructConfig;

@@ -1,4 +1,4 @@
-//! Cost and checksum of one evaluation of the default objective (render + planar, spec §3.2.3)
+//! Cost and checksum of one evaluation of the default objective (render + planar)
 //! on the real working mesh of a run, for profiling the loop's loss.
 //!
 //! Two steps, so the slow preparation (target, init, point cloud) runs once:

@@ -35,7 +35,7 @@ pub struct Prepared<'a> {
 /// Builds the objective once the target is prepared.
 pub type LossFactory = Box<dyn Fn(&Prepared) -> Result<Box<dyn Loss>, PipelineError>>;
 
-/// The planar loss options of `config` (spec §3.2.2), as [`default_loss`] uses them.
+/// The planar loss options of `config`, as [`default_loss`] uses them.
 pub fn planar_options(config: &ReconstructConfig) -> PlanarOptions {
     PlanarOptions {
         knn: KnnOptions {
@@ -51,8 +51,9 @@ pub fn planar_options(config: &ReconstructConfig) -> PlanarOptions {
     }
 }
 
-/// The default objective: `λ1·L_render + λ2·L_planar` (spec §3.2.3), plus
-/// `sdf_loss_weight·L_sdf` (spec §5) when the shape has a signed distance.
+/// The default objective: `λ1·L_render + λ2·L_planar` (the paper's Eq. 2, λ1 = 3 on the render
+/// term: `docs/method.md#decision-weights-of-the-objective`), plus `sdf_loss_weight·L_sdf`
+/// (supplementary §3) when the shape has a signed distance.
 pub fn default_loss(prepared: &Prepared) -> Result<Box<dyn Loss>, PipelineError> {
     let config = prepared.config;
     let planar = PlanarLoss::new(

@@ -30,12 +30,12 @@ pub struct Output {
 pub struct Reconstruction {
     /// Every hyper-parameter.
     pub config: ReconstructConfig,
-    /// Builds the objective (default: λ1·render + λ2·planar, spec §3.2.3).
+    /// Builds the objective (default [`default_loss`]: λ1·render + λ2·planar).
     pub loss_factory: LossFactory,
     /// The remeshing schedule (default [`default_blocks`]: Face Collapse + flips every
     /// `collapse_interval` iterations (1), Face Split every `split_interval` (10), tangential
-    /// smoothing every `smoothing_interval` (0 = off; spec §1.2 has 5, `docs/method.md` says why
-    /// not)).
+    /// smoothing every `smoothing_interval` (0 = off; why:
+    /// `docs/method.md#decision-smoothing-after-the-final-qem-not-in-the-loop`)).
     pub blocks: Vec<ScheduledBlock>,
     /// When set (by another thread, a signal handler, a binding), the run stops with
     /// [`PipelineError::Cancelled`] at its next progress report (once per iteration of the
@@ -69,7 +69,7 @@ impl Reconstruction {
 
     /// Runs the whole pipeline on `shape` (the [`Shape`] module docs give the order of the
     /// calls), reporting progress; the output is in the input's coordinates. The stages, each
-    /// in its own module of `pipeline/`: `prepare` (the shape's set-up and renders), `init` (M0,
+    /// in its own module of `stages/`: `prepare` (the shape's set-up and renders), `init` (M0,
     /// the point cloud, the working budget), `optimize` (the loop), `finish` (untangle, the
     /// final QEMs and the clean-up steps).
     pub fn run(

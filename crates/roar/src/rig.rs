@@ -5,7 +5,7 @@ use roar_render::{Camera, star_cameras};
 
 use crate::config::ReconstructConfig;
 
-/// The camera rig of `config` (spec §3.2.1: the star rig, `views_per_axis²` views of
+/// The camera rig of `config` (the star rig, `views_per_axis²` views of
 /// `render_resolution²` pixels), for which every shape renders its target.
 pub fn rig_cameras(config: &ReconstructConfig) -> Vec<Camera> {
     star_cameras(
@@ -41,7 +41,7 @@ pub(crate) fn coarse_until(config: &ReconstructConfig) -> usize {
     }
 }
 
-/// The target renders' options of `config` (spec §3.1, §3.2.1), as the pipeline uses them.
+/// The target renders' options of `config`, as the pipeline uses them.
 pub fn target_options(config: &ReconstructConfig) -> TargetOptions {
     TargetOptions {
         views_per_axis: config.target.views_per_axis,

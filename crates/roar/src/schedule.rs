@@ -15,11 +15,13 @@ pub struct ScheduledBlock {
     pub block: Box<dyn Block>,
     /// Period in iterations (0 = never).
     pub every: usize,
-    /// Skip iteration 0 (the Face Split block does, spec §1.2).
+    /// Skip iteration 0 (the Face Split block does, as in the authors' code).
     pub skip_first: bool,
 }
 
-/// The paper's schedule (spec §1.2, §1.3).
+/// The paper's schedule (supplementary §1: Face Collapse and flips every iteration, Face Split
+/// every 10), with tangential smoothing every `smoothing_interval` iterations, off by default
+/// (`docs/method.md#decision-smoothing-after-the-final-qem-not-in-the-loop`).
 pub fn default_blocks(config: &ReconstructConfig) -> Vec<ScheduledBlock> {
     vec![
         ScheduledBlock {

@@ -27,7 +27,7 @@ impl Mesh {
     /// Errors: [`TopoError::DeadElement`];
     /// [`TopoError::LinkCondition`] unless the common neighbours of `a = tail(h)` and
     /// `b = head(h)` are exactly the two opposite vertices `c ≠ d` (otherwise the result has a
-    /// non-manifold edge or a pinched vertex; spec §3.11);
+    /// non-manifold edge or a pinched vertex);
     /// [`TopoError::TetrahedronCollapse`] if a wing vertex `c` or `d` has valence 3, or the
     /// survivor would be left with valence `val(a) + val(b) − 4 < 3` (e.g. a tetrahedron
     /// component collapsing into a double triangle).

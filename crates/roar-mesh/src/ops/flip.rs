@@ -31,7 +31,7 @@ impl Mesh {
 
     /// Flips edge `e` inside the quad formed by its two faces; returns `e`, which now joins the
     /// opposite vertices `c` and `d`. Faces keep their ids: `f0` becomes `(a, d, c)`, `f1`
-    /// becomes `(b, c, d)` (spec §3.12). No element is created or removed.
+    /// becomes `(b, c, d)`, both still counter-clockwise. No element is created or removed.
     ///
     /// ```text
     ///          c                        c

@@ -20,8 +20,8 @@ pub struct FaceSplitOutcome {
 }
 
 impl Mesh {
-    /// Splits face `f = (p0, p1, p2)` 1→3 at a new vertex `m = Σ bary[i]·p_i` (spec §3.12 uses
-    /// the centroid, `bary = [1/3; 3]`). The weights are used as given (callers pass weights
+    /// Splits face `f = (p0, p1, p2)` 1→3 at a new vertex `m = Σ bary[i]·p_i` (the Face Split block
+    /// uses the centroid, `bary = [1/3; 3]`). The weights are used as given (callers pass weights
     /// summing to 1). Always legal. Appends 1 vertex, 3 edges and 2 faces.
     ///
     /// ```text

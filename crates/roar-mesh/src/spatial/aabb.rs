@@ -1,7 +1,8 @@
 //! Axis-aligned bounding boxes in f64.
 //!
 //! Naming: an [`Aabb`] is a closed box `[min, max]`; "empty" means no point was added yet
-//! (`min > max`); `diagonal()` is the length of the box diagonal (the `D` of the spec).
+//! (`min > max`); `diagonal()` is the length of the box diagonal (the `D` that sampling densities
+//! and tolerances are relative to).
 
 use glam::DVec3;
 

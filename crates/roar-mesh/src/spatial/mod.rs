@@ -8,17 +8,16 @@
 //! coordinates `[w0, w1, w2]` weight a face's corners in order. Functions never panic on bad
 //! indices: faces that reference a missing vertex are ignored (each function says how).
 //!
-//! Modules: [`aabb`] (boxes), [`normalization`] (into the rig sphere and back),
-//! [`point_triangle`] (one-triangle closest point and ray hit), [`bvh`] (the triangle tree),
-//! [`tri_tri`] (exact triangle–triangle tests), [`filtered_tri_tri`] (the same behind certified
-//! floating-point filters, for many pairs), [`self_intersections`], [`sampling`]
-//! (area-weighted random samples),
+//! Modules: [`aabb`] (boxes), [`normalization`] (into the rig sphere and back), [`point_triangle`]
+//! (one-triangle closest point and ray hit), [`bvh`] (the triangle tree), [`tri_tri`] (exact
+//! triangle–triangle tests), [`filtered_tri_tri`] (the same behind certified floating-point
+//! filters, for many pairs), [`self_intersections`], [`sampling`] (area-weighted random samples),
 //! [`winding`] (fast winding numbers, and the Morton order batched queries visit points in),
-//! [`regular_sampling`] (regular per-face grids),
-//! [`projector`] (the `Projector` trait), [`ray_projector`] (exact ray-cast projection, §3.4 (B)),
-//! [`triangle`] (one triangle's normal, angles and aspect ratio),
-//! [`vertex_normals`](mod@vertex_normals) (vertex normals by named weightings, §2.2), [`sdf`] (the `Sdf` trait
-//! of signed distance inputs), [`isosurface`] (marching tetrahedra over a grid of values).
+//! [`regular_sampling`] (regular per-face grids), [`projector`] (the `Projector` trait),
+//! [`ray_projector`] (exact ray-cast projection), [`triangle`] (one triangle's normal, angles and
+//! aspect ratio), [`vertex_normals`](mod@vertex_normals) (vertex normals by named weightings),
+//! [`sdf`] (the `Sdf` trait of signed distance inputs), [`isosurface`] (marching tetrahedra over a
+//! grid of values).
 
 pub mod aabb;
 pub mod bvh;

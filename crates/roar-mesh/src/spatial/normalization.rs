@@ -2,8 +2,9 @@
 //!
 //! Naming: *apply* maps world (file) coordinates into rig coordinates, *invert* maps rig
 //! coordinates back to world coordinates. The rig sphere has radius [`RIG_RADIUS`] around the
-//! origin (DESIGN.md: "normalize into radius 0.95"; spec §3.1 step 1 translates by the
-//! bounding-box midpoint and scales by the largest vertex norm).
+//! origin: the bounding-box midpoint goes to the origin and the farthest vertex to 0.95, not to
+//! 1 as in the authors' code, so that no silhouette touches the border of a camera's frame
+//! (`docs/method.md#conventions`).
 
 use glam::DVec3;
 

@@ -7,8 +7,8 @@ use glam::DVec3;
 
 /// Closest point of the closed triangle `[a, b, c]` to `p`.
 ///
-/// Input: query point `p`, triangle corners. Output: `(point, [w0, w1, w2])`, the closest point
-/// and its barycentric coordinates. Ericson, *Real-Time Collision Detection* §5.1.5 (Voronoi
+/// Input: query point `p`, triangle corners. Output: `(point, [w0, w1, w2])`, the closest point and
+/// its barycentric coordinates. Ericson, *Real-Time Collision Detection*, section 5.1.5 (Voronoi
 /// regions). Degenerate triangles (zero or near-zero area, repeated corners) are handled as the
 /// union of their three edges, so the answer is always finite for finite input.
 pub fn closest_point_on_triangle(p: DVec3, [a, b, c]: [DVec3; 3]) -> (DVec3, [f64; 3]) {

@@ -1,8 +1,9 @@
-//! Projection of source-mesh samples onto the target surface along their normals (spec §3.4).
+//! Projection of source-mesh samples onto the target surface along their normals, which the
+//! Face Split block scores faces with (`docs/method.md#projection-onto-the-target`).
 //!
-//! One concept, several implementations: k-NN planar projection over the target point cloud
-//! (spec §3.4 (A), in `roar-loss`), exact ray casting onto the target soup guarded by winding
-//! numbers of the source (§3.4 (B), in `spatial`), and the analytic [`SphereProjector`] here, a
+//! One concept, several implementations: k-NN planar projection over the target point cloud (the
+//! paper's, in `roar-loss`), exact ray casting onto the target soup guarded by winding numbers of
+//! the source (the authors' later code, in `spatial`), and the analytic [`SphereProjector`] here, a
 //! reference for tests.
 
 use glam::DVec3;
@@ -11,11 +12,11 @@ use glam::DVec3;
 ///
 /// Contract every implementation keeps:
 /// - `positions`/`triangles` are the current source mesh (so an exact projector can apply
-///   winding-number guards against it, spec §3.4 (B)); implementations that do not need it ignore
+///   winding-number guards against it); implementations that do not need it ignore
 ///   it.
 /// - `points[i]` is a sample and `normals[i]` its **unit** normal; the projection of sample `i`
 ///   lies on the line `points[i] + t·normals[i]`, except where an implementation documents a
-///   fallback (e.g. §3.4 (B) step 5 keeps an obliquely hit sample in place).
+///   fallback (e.g. the ray-cast projector keeps an obliquely hit sample in place).
 /// - The result has exactly `points.len()` entries, in the same order: `Some(q)` is the projected
 ///   point, `None` means the sample has no valid projection (missed, rejected by a guard, too far,
 ///   non-finite input, or no normal because `normals` is shorter than `points`).

@@ -1,6 +1,6 @@
 //! Exact projection of source samples onto a target triangle soup by ray casting, guarded by
-//! winding numbers of the current source mesh (spec §3.4 (B), after [I3D]
-//! `project_to_triangle_soup`).
+//! winding numbers of the current source mesh, after the authors' later code
+//! (`project_to_triangle_soup`; `docs/method.md#projection-onto-the-target`).
 
 use glam::DVec3;
 use rayon::prelude::*;
@@ -9,19 +9,19 @@ use super::bvh::{RayHit, TriangleBvh};
 use super::projector::Projector;
 use super::winding::WindingNumber;
 
-/// Offset of the ray origins from the sample along ∓n (spec §3.4 (B) step 1).
+/// Offset of the ray origins from the sample along ∓n, so a sample on the target still hits it.
 const ORIGIN_OFFSET: f64 = 1e-6;
 
 /// Samples per parallel work item.
 const CHUNK: usize = 2048;
 
-/// Options of [`RayCastProjector`] (spec §3.4 (B)).
+/// Options of [`RayCastProjector`]; the defaults are the authors' code's.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct RayProjectorOptions {
-    /// Largest accepted |τ| (signed move along the normal). Default 0.05 (spec §3.4 (B) step 4).
+    /// Largest accepted |τ| (signed move along the normal). Default 0.05.
     pub max_distance: f64,
     /// A hit whose target face normal `m` has `|m·n| ≤` this is oblique: the sample stays valid
-    /// but does not move. Default 0.7 (spec §3.4 (B) step 5).
+    /// but does not move. Default 0.7.
     pub oblique_gate: f64,
 }
 
@@ -34,7 +34,7 @@ impl Default for RayProjectorOptions {
     }
 }
 
-/// Ray-cast [`Projector`] onto a fixed target triangle soup (spec §3.4 (B)).
+/// Ray-cast [`Projector`] onto a fixed target triangle soup.
 ///
 /// Per sample `s` with unit normal `n`: casts `s + 1e-6 n` along `−n` and `s − 1e-6 n` along
 /// `+n` (unbounded, nearest hit each). For each hit with move `p` (sample → hit point), the

@@ -1,4 +1,5 @@
-//! Regular supersampling of faces (spec §3.3, MESH-style after Aspert et al. 2002).
+//! Regular supersampling of faces, after the MESH sampler of Aspert et al. 2002 that the
+//! authors' code follows (`docs/method.md#regular-samples-of-the-source`).
 //!
 //! Each face gets its own triangular grid of `n(n+1)/2` points (`n` points per side) and
 //! `(n−1)²` sub-triangles oriented like the face, with `n` chosen so that the sample count is
@@ -7,7 +8,7 @@
 //! duplicated. Each sample keeps its barycentric weights in its parent face, so gradients of
 //! anything computed at the samples flow back to the face's three vertices.
 //!
-//! # Grid layout (spec §3.3 steps 4–5)
+//! # Grid layout
 //! For a face `(v0, v1, v2)` and integers `a, b ≥ 0`, `a + b ≤ n − 1`, the point
 //! `p_{a,b} = v0 + a/(n−1)·(v1−v0) + b/(n−1)·(v2−v0)` has barycentrics
 //! `(1 − a/(n−1) − b/(n−1), a/(n−1), b/(n−1))` and local ordinal `(a+b)(a+b+1)/2 + a`.
@@ -24,18 +25,18 @@ use super::winding::{TriangleIndexError, check_triangle_indices};
 /// Barycentrics and local sub-triangles of one grid, as returned by [`face_grid`].
 type FaceGrid = (Vec<[f64; 3]>, Vec<[u32; 3]>);
 
-/// Options of [`regular_samples`] (spec §3.3, Verification note 7).
+/// Options of [`regular_samples`].
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct RegularSamplingOptions {
     /// Sampling density δ as a fraction of the bounding-box diagonal D of the sampled mesh: a face
-    /// gets about `A_f / (δD)²` samples. Default 0.002 (spec §3.3 step 1, the supplementary).
+    /// gets about `A_f / (δD)²` samples. Default 0.002 (supplementary §1.2).
     pub density: f64,
     /// Per-face cap on the grid size `n` (points per side). Default 16, i.e. 136 samples, the
-    /// reference code's effective cap (`max_samples = 20`, Verification note 7 / OQ-6).
-    /// The supplementary's "420 samples" reading would be 28.
+    /// authors' code's effective cap (its `max_samples = 20`); the supplementary's "420 samples"
+    /// would be 28 (`docs/method.md#decision-sample-cap-per-face`).
     pub max_n: u32,
     /// Minimum grid size, used when the area calls for fewer points. Default 3 (6 samples, the
-    /// fewest that measure curvature; spec §3.3 step 3). Values below 2 are treated as 2.
+    /// fewest that measure curvature). Values below 2 are treated as 2.
     pub min_n: u32,
 }
 
@@ -81,7 +82,7 @@ pub struct RegularSamples {
     /// Barycentric weights of each sample w.r.t. its parent face's vertices (sum to 1).
     pub barycentrics: Vec<[f64; 3]>,
     /// Unit normal of each sample: the normalized barycentric blend of the parent's vertex normals
-    /// when supplied (spec §3.3 step 6, "smooth"), else the face's unit normal. Zero when both
+    /// when supplied (the "smooth" normals), else the face's unit normal. Zero when both
     /// are degenerate (zero blend and zero-area face).
     pub normals: Vec<DVec3>,
     /// Grid size `n` (points per side) of each face.
@@ -114,7 +115,7 @@ pub fn grid_point_count(n: u32) -> usize {
     n * (n + 1) / 2
 }
 
-/// Local ordinal of grid point `(a, b)`: `(a+b)(a+b+1)/2 + a` (spec §3.3 step 4).
+/// Local ordinal of grid point `(a, b)`: `(a+b)(a+b+1)/2 + a` (row by row of `a + b`).
 #[inline]
 pub fn grid_ordinal(a: u32, b: u32) -> u32 {
     let s = a + b;
@@ -162,7 +163,7 @@ pub fn face_grid(n: u32) -> (Vec<[f64; 3]>, Vec<[u32; 3]>) {
 }
 
 /// The continuous grid size `n'_f = sqrt(1/4 + T_f/(D²δ²)) − 1/2` of a face with doubled area
-/// `doubled_area` (spec §3.3 step 1), so that `n'(n'+1)/2 = A_f/(Dδ)²`. Returns 0 for
+/// `doubled_area`, so that `n'(n'+1)/2 = A_f/(Dδ)²`. Returns 0 for
 /// non-finite or degenerate input (which then falls back to the minimum grid).
 pub fn continuous_grid_size(doubled_area: f64, diagonal: f64, density: f64) -> f64 {
     let scale = diagonal * diagonal * density * density;
@@ -174,12 +175,12 @@ pub fn continuous_grid_size(doubled_area: f64, diagonal: f64, density: f64) -> f
     }
 }
 
-/// Picks the integer grid size of a face from its continuous size `n_cont` (spec §3.3 steps 2–3):
+/// Picks the integer grid size of a face from its continuous size `n_cont`:
 ///
 /// 1. clip: `n_cont ≥ max_n − 1` counts as clipped and always gets `n = max_n`. This reproduces
-///    the reference code, which clips `n'` to `max_samples − 5` *before* the stochastic rounding
-///    and then rounds a clipped face up, so its effective cap is `max_n = 16` (Verification
-///    note 7).
+///    the authors' code, which clips `n'` to `max_samples − 5` *before* the stochastic rounding
+///    and then rounds a clipped face up, so its effective cap is `max_n = 16`
+///    (`docs/method.md#decision-sample-cap-per-face`).
 /// 2. `n_cont < min_n` gives `n = min_n`.
 /// 3. otherwise unbiased stochastic rounding: with `k = ⌊n'⌋`, `N* = n'(n'+1)/2`, keep `k` with
 ///    probability `p = ((k+1)(k+2)/2 − N*)/(k+1)`, else `k + 1`, so `E[n(n+1)/2] = N*` exactly.
@@ -203,7 +204,7 @@ pub fn round_grid_size(n_cont: f64, min_n: u32, max_n: u32, rng: &mut impl Rng) 
     (n as u32).clamp(min_n, max_n)
 }
 
-/// Regular supersampling of every face of `(positions, triangles)` (spec §3.3).
+/// Regular supersampling of every face of `(positions, triangles)`.
 ///
 /// `vertex_normals`, when given, must hold one normal per position; sample normals are then the
 /// normalized barycentric blend of the parent's vertex normals (falling back to the face normal

@@ -1,8 +1,8 @@
 //! Seeded, area-weighted random sampling of a triangle surface.
 //!
 //! Naming: a *sample* is a point on a face with its face index, barycentric coordinates (corner
-//! order of the face) and the unit normal of its face. Spec §3.1 (b): faces are drawn with
-//! probability proportional to area, barycentrics are `(1−√u, √u(1−v), √u·v)` with
+//! order of the face) and the unit normal of its face. As in the authors' code, faces are drawn
+//! with probability proportional to area, barycentrics are `(1−√u, √u(1−v), √u·v)` with
 //! `u, v ~ U(0, 1)`. Same input and seed give the same samples on every machine.
 
 use glam::DVec3;

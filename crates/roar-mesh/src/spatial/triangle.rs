@@ -5,7 +5,7 @@ use crate::{DEGENERATE_CROSS, DEGENERATE_NORMAL};
 use glam::DVec3;
 
 /// Unit normal of triangle `(a, b, c)`; a triangle with `|cross| ≤ 1e-9` (or non-finite corners)
-/// gets `(1, 0, 0)` (spec §2.2).
+/// gets `(1, 0, 0)` (`docs/method.md#conventions`).
 pub fn triangle_normal(a: DVec3, b: DVec3, c: DVec3) -> DVec3 {
     let n = (b - a).cross(c - a);
     let len = n.length();
@@ -16,7 +16,7 @@ pub fn triangle_normal(a: DVec3, b: DVec3, c: DVec3) -> DVec3 {
     }
 }
 
-/// Interior angles of triangle `p` at its three corners, from the clipped cosine (spec §2.2).
+/// Interior angles of triangle `p` at its three corners, from the clipped cosine.
 /// A corner with a zero-length side gets π/2 (its cosine is taken as 0).
 pub fn corner_angles(p: [DVec3; 3]) -> [f64; 3] {
     std::array::from_fn(|k| {
@@ -27,10 +27,10 @@ pub fn corner_angles(p: [DVec3; 3]) -> [f64; 3] {
 }
 
 /// The aspect ratio `Q = R/(2r) = abc·s/(8K²)` of triangle `p` (circumradius over twice the
-/// inradius, spec §2.2), the one triangle-quality measure of the project: 1 for an equilateral
-/// triangle, growing without bound for slivers and needles. A collinear triangle with three
-/// non-zero sides gives +∞; one with a zero-length side (0/0) gives NaN, which callers treat as
-/// degenerate. The area comes from the cross product, exact to rounding for flat triangles where
+/// inradius, supplementary §1.1), the one triangle-quality measure of the project: 1 for an
+/// equilateral triangle, growing without bound for slivers and needles. A collinear triangle with
+/// three non-zero sides gives +∞; one with a zero-length side (0/0) gives NaN, which callers treat
+/// as degenerate. The area comes from the cross product, exact to rounding for flat triangles where
 /// Heron's `(s−a)(s−b)(s−c)` cancels.
 pub fn triangle_quality([p0, p1, p2]: [DVec3; 3]) -> f64 {
     let (a, b, c) = (p1.distance(p2), p2.distance(p0), p0.distance(p1));

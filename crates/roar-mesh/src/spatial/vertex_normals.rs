@@ -6,9 +6,9 @@ use super::triangle::{corner_angles, triangle_normal};
 use crate::DEGENERATE_CROSS;
 use glam::DVec3;
 
-/// The ROAR weighting (spec §2.2) of face `p`: its unit normal and, at each corner, its area
-/// **times** the corner angle. A degenerate face (`|cross| ≤ 1e-9`) has normal `(1, 0, 0)` and
-/// area 1e-9, as the reference does.
+/// The ROAR weighting (`docs/method.md#conventions`) of face `p`: its unit normal and, at each
+/// corner, its area **times** the corner angle. A degenerate face (`|cross| ≤ 1e-9`) has normal
+/// `(1, 0, 0)` and area 1e-9, as the authors' code does.
 pub fn area_angle_weights(p: [DVec3; 3]) -> (DVec3, [f64; 3]) {
     let len = (p[1] - p[0]).cross(p[2] - p[0]).length();
     let area = if len > DEGENERATE_CROSS && len.is_finite() {
@@ -20,7 +20,7 @@ pub fn area_angle_weights(p: [DVec3; 3]) -> (DVec3, [f64; 3]) {
     (normal, corner_angles(p).map(|angle| area * angle))
 }
 
-/// ROAR vertex normals (spec §2.2): `N_v = Σ_{f∋v} A_f θ_{f,v} n_f`, normalized (weights of
+/// ROAR vertex normals: `N_v = Σ_{f∋v} A_f θ_{f,v} n_f`, normalized (weights of
 /// [`area_angle_weights`]); what the losses and the finish use.
 pub fn vertex_normals(positions: &[DVec3], triangles: &[[u32; 3]]) -> Vec<DVec3> {
     let mut sums = vec![DVec3::ZERO; positions.len()];

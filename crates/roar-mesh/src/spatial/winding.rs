@@ -1,4 +1,5 @@
-//! Generalized winding numbers of triangle soups (spec §3.1 (b), §3.4 (B)).
+//! Generalized winding numbers of triangle soups: the point cloud's sample filter, the
+//! watertight init's enclosure rule, the ray-cast projector's guards and the untangle's probes.
 //!
 //! The winding number of a soup at a point `q` is `w(q) = (1/4π) Σ_t Ω_t(q)`, the signed solid
 //! angles of its triangles seen from `q`. For a closed, outward-oriented mesh it is 1 inside and 0

@@ -22,9 +22,9 @@ use std::collections::BTreeMap;
 pub struct BlockContext<'a> {
     /// Iteration number of the main loop (also mixed into the seeds of stochastic blocks).
     pub iteration: usize,
-    /// The face budget B of the Face Split block (spec §3.8).
+    /// The face budget B of the Face Split block (the pipeline passes its working budget).
     pub face_budget: usize,
-    /// Projector onto the target for the face scores (spec §3.4); blocks that need it and get
+    /// Projector onto the target for the face scores; blocks that need it and get
     /// `None` do nothing and say so in their stats (`rejected["no_projector"]`).
     pub projector: Option<&'a dyn Projector>,
 }

@@ -1,5 +1,6 @@
-//! The Face Collapse block: self-intersection attenuation by collapsing folded faces (spec §3.6
-//! as amended by Verification note 4), followed by the edge flips of §3.7.
+//! The Face Collapse block: self-intersection attenuation by collapsing folded faces, as the
+//! authors' code does with the supplementary's slack (`docs/method.md#face-collapse-and-flips`),
+//! followed by the valence-improving edge flips.
 //!
 //! 1. Flag face f when `n_f · (n_v0 + n_v1 + n_v2) < slack` (unit vertex normals, slack 0.6).
 //!    Optional gate (off here, on in the pipeline): skip faces whose `|n_o(f)| = |Σ n_vk| / 3`
@@ -9,7 +10,7 @@
 //!    flip, and optionally (off for fold removal) no resulting face may have `Q > 5`. An edge
 //!    with no valid placement drops out; otherwise the placement with lower QSlim cost decides
 //!    which endpoint survives.
-//! 4. Independent selection (§3.11), collapse (the survivor keeps the chosen endpoint's position
+//! 4. Independent selection, collapse (the survivor keeps the chosen endpoint's position
 //!    and optimizer row), compact, then flips.
 
 use crate::blocks::block::{Block, BlockContext, BlockStats};
@@ -20,28 +21,29 @@ use crate::blocks::select::{SelectOptions, select_independent_edges};
 use crate::geometry::Geometry;
 use roar_mesh::{Mesh, TrackedMesh};
 
-/// Options of [`face_collapse`] (spec §3.6, note 4).
+/// Options of [`face_collapse`] (`docs/method.md#decision-fold-estimator-and-its-gates`).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct FaceCollapseOptions {
-    /// A face is flagged when `n_f · Σ_k n_{v_k} < fold_slack`. Default 0.6 (note 4: the
-    /// supplementary's slack added to the code's 0).
+    /// A face is flagged when `n_f · Σ_k n_{v_k} < fold_slack`. Default 0.6 (the
+    /// supplementary's slack added to the authors' code's 0).
     pub fold_slack: f64,
-    /// Off-by-default gate: do not collapse flagged faces whose vertex-derived normal
-    /// `|n_o(f)|` is below this ("normal size 0.98", note 4), unless they fold back onto a
-    /// neighbour ([`folds_onto_a_neighbour`]). `None` = off.
+    /// Off-by-default gate: do not collapse flagged faces whose vertex-derived normal `|n_o(f)|` is
+    /// below this (the supplementary's "normal size 0.98"), unless they fold back onto a neighbour
+    /// ([`folds_onto_a_neighbour`]). `None` = off.
     pub min_normal_size: Option<f64>,
-    /// Collapse validity; default: flip test only, `max_quality: None` (note 4: the Q ≤ 5 check
-    /// is off for fold removal).
+    /// Collapse validity; default: flip test only, `max_quality: None`: as in the authors' code,
+    /// the Q ≤ 5 check is off for fold removal
+    /// (`docs/method.md#decision-fold-estimator-and-its-gates`).
     pub validity: ValidityOptions,
-    /// QSlim weights and vertex-plane variant used to choose the placement (§3.10).
+    /// QSlim weights and vertex-plane variant used to choose the placement.
     pub qslim: QSlimOptions,
-    /// Independent selection (§3.11).
+    /// Independent selection.
     pub select: SelectOptions,
-    /// Edge flips run after the collapses (§3.6 step 7); `None` skips them.
+    /// Edge flips run after the collapses; `None` skips them.
     pub flips: Option<FlipOptions>,
     /// Skip collapses that would make a face intersect another one
-    /// ([`IntersectionGuard`], `rejected["intersection"]`). Default off (the paper's block);
-    /// the pipeline's `guard_intersections` key switches it on. [INF]
+    /// ([`IntersectionGuard`], `rejected["intersection"]`). Default off (the paper's block
+    /// has none); the pipeline's `guard_intersections` key switches it on.
     pub guard_intersections: bool,
 }
 
@@ -59,12 +61,12 @@ impl Default for FaceCollapseOptions {
     }
 }
 
-/// Faces flagged by the fold estimator of §3.6 step 1 (note 4), by face slot.
+/// Faces flagged by the fold estimator, by face slot.
 ///
 /// With the normal-size gate on, a flagged face whose vertex normals diverge (`|n_o(f)|` below
 /// the gate) is spared unless it turns back on a neighbour ([`folds_onto_a_neighbour`]): the
 /// gate is meant for creases and thin parts, whose sharp edges are convex, and a fold's vertex
-/// normals diverge too [INF].
+/// normals diverge too (our rule; the paper does not say).
 pub fn flagged_faces(mesh: &Mesh, geometry: &Geometry, options: &FaceCollapseOptions) -> Vec<bool> {
     let mut flags = vec![false; mesh.face_capacity()];
     for f in mesh.faces() {
@@ -99,7 +101,7 @@ pub fn folds_onto_a_neighbour(mesh: &Mesh, geometry: &Geometry, f: roar_mesh::Fa
     })
 }
 
-/// Runs the Face Collapse block (spec §3.6, note 4) and then the flips; compacts the mesh and
+/// Runs the Face Collapse block and then the flips; compacts the mesh and
 /// the optimizer rows if anything collapsed.
 ///
 /// Stats: `candidates` = candidate edges (edges of flagged faces); `accepted` = collapses;

@@ -1,4 +1,5 @@
-//! Valence-improving edge flips (spec §3.7, Verification note 3).
+//! Valence-improving edge flips (the authors' code, after Continuous Remeshing; the feature
+//! gate is the supplementary's, `docs/method.md#decision-flip-gate`).
 //!
 //! Round by round: every not-yet-flipped edge (a, b) with opposite vertices c (left) and d
 //! (right) is a candidate when
@@ -12,29 +13,30 @@
 //! its rank (g, ties to the lower index) is the highest among the candidates touching any of its
 //! four vertices, so flips of one round never share a vertex. Flipped edges leave the pool (each
 //! edge flips at most once per call); stop after `max_rounds` or when nothing flips.
-//! [INF: the 2000 cap applies to the edges passing the tests, so a large mesh is not stuck on
-//! its first 2000 edges.]
+//! The 2000 cap applies to the edges passing the tests, so a large mesh is not stuck on its first
+//! 2000 edges (our choice: `docs/method.md#decision-flip-candidate-cap`).
 
 use crate::blocks::block::{Block, BlockContext, BlockStats};
 use crate::blocks::guard::IntersectionGuard;
 use roar_mesh::spatial::triangle_normal;
 use roar_mesh::{EdgeId, Mesh, TrackedMesh};
 
-/// Options of [`flip_edges`] (spec §3.7).
+/// Options of [`flip_edges`]; the defaults are the authors' code's.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct FlipOptions {
-    /// Maximum number of rounds. Default 10 (§3.7, `max_iter`).
+    /// Maximum number of rounds. Default 10 (`max_iter`).
     pub max_rounds: usize,
-    /// Candidates considered per round. Default 2000 (§3.7).
+    /// Candidates considered per round. Default 2000.
     pub max_candidates_per_round: usize,
     /// Feature gate: flip only edges with `|n_L·n_R| ≥` this value; `None` disables the gate.
-    /// Default `Some(0.95)` (§3.7 step 3, [SUP]; note 3 keeps it switchable).
+    /// Default `Some(0.95)` (supplementary §1.2); switchable, since it also blocks valence fixes
+    /// across edges bent by more than about 18°.
     pub min_abs_flatness: Option<f64>,
-    /// Tolerance of the normal check `N_old · n_new > −tol`. Default 1e-8 (§3.7 step 2).
+    /// Tolerance of the normal check `N_old · n_new > −tol`. Default 1e-8.
     pub normal_tolerance: f64,
     /// Skip flips whose new faces would intersect another face ([`IntersectionGuard`],
-    /// `rejected["intersection"]`). Default off (the paper's block); the pipeline's
-    /// `guard_intersections` key switches it on. [INF]
+    /// `rejected["intersection"]`). Default off (the paper's block has none); the
+    /// pipeline's `guard_intersections` key switches it on.
     pub guard_intersections: bool,
 }
 
@@ -50,7 +52,7 @@ impl Default for FlipOptions {
     }
 }
 
-/// Runs the valence-improving flips of spec §3.7 on all edges. Flips move no vertex, so the
+/// Runs the valence-improving flips on all edges. Flips move no vertex, so the
 /// optimizer needs no update and the mesh needs no compaction.
 ///
 /// Stats (summed over rounds): `candidates` = edges with positive gain looked at;
@@ -182,7 +184,7 @@ impl Block for EdgeFlips {
 mod tests {
     use super::*;
 
-    /// The defaults the docs of [`FlipOptions`] state (spec §3.7).
+    /// The defaults the docs of [`FlipOptions`] state.
     #[test]
     fn documented_defaults() {
         let o = FlipOptions::default();

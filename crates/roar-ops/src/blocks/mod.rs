@@ -1,4 +1,4 @@
-//! The loop's remeshing blocks (spec §1.2): Face Collapse with its edge flips, Face Split and
+//! The loop's remeshing blocks: Face Collapse with its edge flips, Face Split and
 //! tangential smoothing, behind the [`Block`] trait, with what they share: candidate selection
 //! ([`select`]), edge costs ([`qslim`]) and the exact self-intersection guard ([`guard`]).
 //!

@@ -1,5 +1,6 @@
-//! ROAR's QSlim edge cost and placement (spec §3.10, Verification note 5) with the collapse
-//! validity simulation (spec §3.6 step 3, §3.8 step 2).
+//! ROAR's QSlim edge cost and placement, as in the authors' code
+//! (`docs/method.md#collapse-cost-and-placement`), with the collapse validity simulation that
+//! the Face Collapse and Face Split blocks share.
 //!
 //! Per vertex a quadric `(A, b, c)` sums planes `(n, d = −n·x0)` as `A += w n nᵀ`,
 //! `b += w d n`, `c += w d²`: the planes of its faces (weight 100, no area weighting), the
@@ -13,15 +14,16 @@ use roar_mesh::spatial::triangle_quality;
 use roar_mesh::{DEGENERATE_CROSS, DVec3, EdgeId, HalfedgeId, Mesh, VertexId};
 
 /// How the vertex plane's "generalized normal" blends the vertex normal with the Laplacian
-/// (spec §3.10, Verification note 5).
+/// (`docs/method.md#decision-vertex-plane-of-the-collapse-cost`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum VertexPlane {
-    /// The reference code: `ñ = normalize(N_v |N_v|² + δ_v (1 − |N_v|)²)` with the raw
-    /// area×angle weighted normal `N_v`. `|N_v|` scales with the squared edge length, so on fine
-    /// meshes the plane follows the Laplacian direction δ_v. Default (note 5).
+    /// The authors' code: `ñ = normalize(N_v |N_v|² + δ_v (1 − |N_v|)²)` with the raw area×angle
+    /// weighted normal `N_v`. `|N_v|` scales with the squared edge length, so on fine meshes the
+    /// plane follows the Laplacian direction δ_v. Default, the behaviour the paper's results came
+    /// from.
     #[default]
     RawMagnitude,
-    /// Scale-free variant [INF, OQ-22]: `|N_v|` replaced by μ_v, i.e.
+    /// Scale-free variant (ours): `|N_v|` replaced by μ_v, i.e.
     /// `ñ = normalize(n_v μ_v³ + δ_v (1 − μ_v)²)`; on flat patches (μ = 1) the plane is the
     /// tangent plane, so in-plane collapses are free.
     NormalizedMagnitude,
@@ -29,16 +31,16 @@ pub enum VertexPlane {
     None,
 }
 
-/// Weights of the three plane families (spec §3.10).
+/// Weights of the three plane families; the defaults are the authors' code's.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct QSlimOptions {
-    /// Weight of each face plane at its three vertices. Default 100 (§3.10).
+    /// Weight of each face plane at its three vertices. Default 100.
     pub face_weight: f64,
-    /// Weight of each edge bisector plane at its two endpoints. Default 1 (§3.10).
+    /// Weight of each edge bisector plane at its two endpoints. Default 1.
     pub edge_weight: f64,
-    /// Weight of the vertex plane. Default 100 (§3.10).
+    /// Weight of the vertex plane. Default 100.
     pub vertex_weight: f64,
-    /// Vertex plane variant. Default [`VertexPlane::RawMagnitude`] (note 5).
+    /// Vertex plane variant. Default [`VertexPlane::RawMagnitude`].
     pub vertex_plane: VertexPlane,
 }
 
@@ -53,7 +55,7 @@ impl Default for QSlimOptions {
     }
 }
 
-/// Per-vertex quadrics (by vertex slot) of the current mesh (spec §3.10).
+/// Per-vertex quadrics (by vertex slot) of the current mesh.
 pub fn vertex_quadrics(mesh: &Mesh, geometry: &Geometry, options: &QSlimOptions) -> Vec<Quadric> {
     let mut q = vec![Quadric::default(); mesh.vertex_capacity()];
     for f in mesh.faces() {
@@ -97,7 +99,7 @@ pub fn edge_bisector(n_l: DVec3, n_r: DVec3, edge: DVec3) -> DVec3 {
     }
 }
 
-/// The vertex plane's generalized normal (spec §3.10, note 5); falls back to the unit vertex
+/// The vertex plane's generalized normal ([`VertexPlane`]); falls back to the unit vertex
 /// normal, then to +x, when the blend vanishes.
 pub fn generalized_vertex_normal(
     mesh: &Mesh,
@@ -133,13 +135,14 @@ pub fn generalized_vertex_normal(
         .unwrap_or(DVec3::X)
 }
 
-/// Validity rules of the collapse simulation (spec §3.6 step 3, §3.8 step 2).
+/// Validity rules of the collapse simulation.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ValidityOptions {
     /// Reject a placement if a resulting face has quality `Q` above this; `None` disables the
-    /// check. The Face Split block uses `Some(5.0)` (§3.8); fold removal uses `None` (note 4).
+    /// check. The Face Split block uses `Some(5.0)` (supplementary §1.2); fold removal uses
+    /// `None`, as the authors' code (`docs/method.md#decision-fold-estimator-and-its-gates`).
     pub max_quality: Option<f64>,
-    /// Edges shorter than this skip both checks. Default 1e-5 (§3.6 step 3).
+    /// Edges shorter than this skip both checks. Default 1e-5 (the authors' code).
     pub skip_checks_below_length: f64,
 }
 
@@ -184,13 +187,14 @@ impl Invalid {
 }
 
 /// The QSlim cost of collapsing edge `e` onto the better of its two valid endpoint placements
-/// (spec §3.10), or why neither is valid. Ties go to the edge's head.
+/// (module docs), or why neither is valid. Ties go to the edge's head.
 ///
 /// Validity of "keep k, remove r": no face around r (other than the two faces of `e`, which
 /// vanish) flips when r moves to k (`n_before · n_after < 0`; faces degenerate before or after
 /// do not count), and, if enabled, none of those faces ends with `Q > max_quality` (a NaN Q
-/// counts as 1). The faces around k do not move, so they cannot change. [INF: only the faces
-/// that change are quality-checked, so an already bad neighbour of k does not veto.]
+/// counts as 1). The faces around k do not move, so they cannot change. Only the faces that
+/// change are quality-checked (our reading; the paper does not say), so an already bad
+/// neighbour of k does not veto.
 pub fn edge_cost(
     mesh: &Mesh,
     quadrics: &[Quadric],

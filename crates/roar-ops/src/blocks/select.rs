@@ -1,4 +1,5 @@
-//! Independent (non-interfering) edge selection with the link condition (spec §3.11).
+//! Independent (non-interfering) edge selection with the link condition, after the authors' code
+//! (`docs/method.md#independent-edge-selection`).
 //!
 //! Each round ranks the edges by priority (ascending, ties by edge index, so the result is
 //! deterministic), takes local maxima of the rank within about three edges (three propagation
@@ -9,14 +10,14 @@
 
 use roar_mesh::{EdgeId, Mesh, VertexId};
 
-/// Options of [`select_independent_edges`] (spec §3.11).
+/// Options of [`select_independent_edges`]; the defaults are the authors' code's.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct SelectOptions {
-    /// Number of selection rounds. Default 5 (§3.11).
+    /// Number of selection rounds. Default 5.
     pub rounds: usize,
-    /// Rank propagation passes (vertex → edge → vertex). Default 3 (§3.11 step 1).
+    /// Rank propagation passes (vertex → edge → vertex). Default 3.
     pub propagation: usize,
-    /// Edges within this many rings of a kept edge leave the pool. Default 3 (§3.11 step 3).
+    /// Edges within this many rings of a kept edge leave the pool. Default 3.
     pub exclusion_rings: usize,
 }
 

@@ -1,4 +1,5 @@
-//! Tangential smoothing ("improve quality", spec §3.9): one Jacobi sweep moving every smooth
+//! Tangential smoothing ("improve quality", supplementary §1.2 and the authors' formula;
+//! `docs/method.md#tangential-smoothing`): one Jacobi sweep moving every smooth
 //! vertex toward the area-weighted barycentre of its incident face centroids, within its
 //! tangent plane, then back onto the surface it left. Sizing field s ≡ 1.
 //!
@@ -8,8 +9,8 @@
 //! v'' = the point of v's incident faces (before the sweep) nearest to v'
 //! ```
 //!
-//! The last line is ours ([INF], as in isotropic remeshing, where tangential relaxation is
-//! followed by a projection back onto the surface): on a curved or creased neighbourhood
+//! The last line is ours, not the paper's (as in isotropic remeshing, where tangential relaxation
+//! is followed by a projection back onto the surface): on a curved or creased neighbourhood
 //! (μ_v < 1) a move in the tangent plane leaves the surface, by up to about 15 % of the move at
 //! μ_v = 0.98. Without it each sweep undid part of the optimization: on
 //! cgal-non_manifold_face_graph at 1000 faces the render loss jumped by about 25 % after every
@@ -22,15 +23,15 @@ use crate::untangle::{LimiterOptions, limit_steps};
 use roar_mesh::spatial::closest_point_on_triangle;
 use roar_mesh::{DVec3, Mesh, TrackedMesh};
 
-/// Options of [`tangential_smoothing`] (spec §3.9).
+/// Options of [`tangential_smoothing`].
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SmoothingOptions {
     /// Vertices with normal magnitude μ_v below this stay put (creases, spikes, folds).
-    /// Default 0.98 ([SUP], §3.9).
+    /// Default 0.98 (supplementary §1.2).
     pub min_normal_magnitude: f64,
     /// Shorten or cancel moves that would make faces intersect ([`limit_steps`], counted in
-    /// `counters["shortened"]`, `counters["cancelled"]`). Default off (the paper's block); the
-    /// pipeline's `guard_intersections` key switches it on. [INF]
+    /// `counters["shortened"]`, `counters["cancelled"]`). Default off (the paper's block has
+    /// none); the pipeline's `guard_intersections` key switches it on.
     pub guard_intersections: bool,
 }
 
@@ -43,7 +44,7 @@ impl Default for SmoothingOptions {
     }
 }
 
-/// One sweep of tangential smoothing (spec §3.9). All new positions are computed from the old
+/// One sweep of tangential smoothing. All new positions are computed from the old
 /// ones (Jacobi), so the result does not depend on the vertex order. No topology change.
 ///
 /// Stats: `candidates` = live vertices, `accepted` = vertices moved, `rejected["crease"]` =

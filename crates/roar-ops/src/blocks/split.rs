@@ -1,19 +1,21 @@
-//! The Face Split block: resolution allocation under a face budget (spec §3.5, §3.8,
-//! Verification notes 1, 5, 8).
+//! The Face Split block: resolution allocation under a face budget, as in the authors' code
+//! (`docs/method.md#face-split`).
 //!
-//! 1. Regular samples of every face (§3.3) with smooth normals, projected onto the target by a
-//!    [`Projector`] (§3.4).
-//! 2. Face scores (§3.5): on each face's projected grid, ROAR vertex normals from the valid
-//!    projected sub-triangles; per sub-triangle `fold(t) = 1 − (1/3) Σ_c ñ_t·ñ_c`, zeroed when
-//!    folded (> 1), invalid, flipped against the source face, or below the threshold (note 1:
-//!    0.02 per sub-triangle by default; the per-face rule is a switch); `S_f = Σ_t fold(t)`,
-//!    zeroed for folded source faces (φ_f > 1) and faces with an edge shorter than 5e-4.
+//! 1. Regular samples of every face with smooth normals, projected onto the target by a
+//!    [`Projector`].
+//! 2. Face scores: on each face's projected grid, ROAR vertex normals from the valid projected
+//!    sub-triangles; per sub-triangle `fold(t) = 1 − (1/3) Σ_c ñ_t·ñ_c`, zeroed when folded (> 1),
+//!    invalid, flipped against the source face, or below the threshold (0.02 per sub-triangle by
+//!    default, as the authors' scoring code; the per-face rule is a switch:
+//!    `docs/method.md#decision-face-score-threshold`); `S_f = Σ_t fold(t)`, zeroed for folded
+//!    source faces (φ_f > 1) and faces with an edge shorter than 5e-4.
 //! 3. Edge costs `C_e = P_e + QS_e` (P_e = max S over faces touching either endpoint, QS_e = the
 //!    QSlim cost of the best valid placement with the flip and Q ≤ 5 tests, +∞ if none),
 //!    suppression of faces next to edges with `C_e < 1e-3`, independent set with priorities
 //!    `exp(−C_e)`, `c_e = max(C_e, P_e)`.
-//! 4. Pairing and budget (§3.8 steps 6–7, note 8), then collapses, then 1→3 centroid splits
-//!    (the tracked store hears of each: the new vertex gets the mean optimizer row), then compaction.
+//! 4. Pairing and budget (`docs/method.md#decision-budget-logic-of-the-face-split-block`), then
+//!    collapses, then 1→3 centroid splits (the tracked store hears of each: the new vertex gets the
+//!    mean optimizer row), then compaction.
 
 use crate::blocks::block::{Block, BlockContext, BlockStats};
 use crate::blocks::collapse::apply_collapse;
@@ -34,13 +36,16 @@ use roar_mesh::spatial::{
 use roar_mesh::{DEGENERATE_CROSS, DVec3, EdgeId, FaceId, Mesh, TrackedMesh};
 use std::cell::RefCell;
 
-/// Where the 0.02 curvature threshold of the face score applies (Verification note 1).
+/// Where the 0.02 curvature threshold of the face score applies
+/// (`docs/method.md#decision-face-score-threshold`). Some threshold is needed either way: with 0,
+/// rounding noise makes flat faces score.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum SplitThreshold {
-    /// A sub-triangle whose fold is below the value counts 0 (the scoring code). Default 0.02.
+    /// A sub-triangle whose fold is below the value counts 0 (the authors' scoring code).
+    /// Default 0.02.
     PerSubTriangle(f64),
     /// Sub-triangles count whatever their fold; a face whose total is below the value scores
-    /// 0 ([SUP] read per face, OQ-5).
+    /// 0 (the supplementary's threshold read per face).
     PerFace(f64),
 }
 
@@ -50,25 +55,28 @@ impl Default for SplitThreshold {
     }
 }
 
-/// Options of [`face_split`] (spec §3.5, §3.8, notes 1, 5, 8).
+/// Options of [`face_split`]; the defaults are the authors' code's.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct FaceSplitOptions {
-    /// Regular sampling of the faces (§3.3; density 0.002, cap n = 16).
+    /// Regular sampling of the faces (density 0.002, cap n = 16).
     pub sampling: RegularSamplingOptions,
-    /// Score threshold (note 1). Default 0.02 per sub-triangle.
+    /// Score threshold. Default 0.02 per sub-triangle (supplementary §1.2, applied as the authors'
+    /// code applies it).
     pub threshold: SplitThreshold,
-    /// Faces with an edge shorter than this score 0. Default 5e-4 = 0.1·edge_len_min (§3.5).
+    /// Faces with an edge shorter than this score 0. Default 5e-4 = 0.1·edge_len_min (the
+    /// authors' code).
     pub min_edge_length: f64,
     /// τ_e: edges with `C_e` below this suppress their faces' scores and are collapsed for
-    /// free. Default 1e-3 (`edge_curvature_threshold`, §3.8).
+    /// free. Default 1e-3 (`edge_curvature_threshold`).
     pub edge_cost_threshold: f64,
-    /// Cap on splits per call. Default 4000 (`max_faces_to_split`, §3.8, note 8).
+    /// Cap on splits per call. Default 4000 (`max_faces_to_split`, a constant in the
+    /// authors' code).
     pub max_faces_to_split: usize,
-    /// Collapse validity: flip test and `Q ≤ 5` (`collapse_quality_threshold`, §3.8 step 2).
+    /// Collapse validity: flip test and `Q ≤ 5` (`collapse_quality_threshold`; supplementary §1.2).
     pub validity: ValidityOptions,
-    /// QSlim weights and vertex-plane variant (§3.10, note 5).
+    /// QSlim weights and vertex-plane variant.
     pub qslim: QSlimOptions,
-    /// Independent selection (§3.11).
+    /// Independent selection.
     pub select: SelectOptions,
     /// Seed of the sampler's stochastic rounding (the block wrapper mixes in the iteration).
     pub seed: u64,
@@ -80,8 +88,8 @@ pub struct FaceSplitOptions {
     pub prune_edge_costs: bool,
     /// Skip budget collapses that would make a face intersect another one
     /// ([`IntersectionGuard`], `rejected["intersection"]`; the swap's split is dropped with it).
-    /// The centroid splits move no geometry and need no guard. Default off (the paper's block);
-    /// the pipeline's `guard_intersections` key switches it on. [INF]
+    /// The centroid splits move no geometry and need no guard. Default off (the paper's block
+    /// has none); the pipeline's `guard_intersections` key switches it on.
     pub guard_intersections: bool,
 }
 
@@ -106,7 +114,7 @@ impl Default for FaceSplitOptions {
     }
 }
 
-/// Face scores `S_f` (spec §3.5) of a **compact** mesh, by face id, from its regular samples and
+/// Face scores `S_f` of a **compact** mesh, by face id, from its regular samples and
 /// their projections (`projected[i]` for `samples.points[i]`). Runs in parallel over faces
 /// (deterministic: each face is independent).
 pub fn face_scores(
@@ -181,9 +189,10 @@ fn grid_scores(
         .collect()
 }
 
-/// `Σ_t fold(t)` over one face's projected grid (§3.5 steps 1–4): its `count` samples start at
+/// `Σ_t fold(t)` over one face's projected grid (module docs, step 2): its `count` samples start at
 /// `start` in `projected` and `sub_triangles` index them from 0. `normals`/`subs` are scratch.
-/// [INF: a projected sub-triangle with `|cross| ≤ 1e-9` counts as invalid.]
+/// A projected sub-triangle with `|cross| ≤ 1e-9` counts as invalid (our rule; the paper does
+/// not say).
 ///
 /// The ROAR vertex normal weight `area · angle · n_t` is accumulated as `angle · cross_t`
 /// (`cross_t = 2·area·n_t`; the common factor vanishes in the normalization), so only the face
@@ -255,7 +264,7 @@ thread_local! {
     static SAMPLE_BUFFERS: RefCell<SamplePoints> = RefCell::new(SamplePoints::default());
 }
 
-/// Runs the Face Split block (spec §3.8) with face budget `face_budget` and target projector
+/// Runs the Face Split block with face budget `face_budget` and target projector
 /// `projector`; compacts the mesh (and so the tracked store's rows) if the topology changed. Keeps its sample
 /// buffers per thread between calls (see `SAMPLE_BUFFERS`).
 ///
@@ -353,7 +362,7 @@ pub fn face_split(
     }
     stats.count("suppressed_edges", suppressed);
 
-    // Faces by S descending (§3.8 step 6).
+    // Faces by S descending.
     let mut ranked: Vec<FaceId> = mesh.faces().filter(|f| scores[f.index()] > 0.0).collect();
     ranked.sort_by(|x, y| {
         scores[y.index()]
@@ -448,12 +457,12 @@ fn priority_floor(t: f64) -> f64 {
     (-(t + PRIORITY_MARGIN)).exp()
 }
 
-/// QSlim edge costs `C_e = P_e + QS_e` of the Face Split block (spec §3.8 step 2), computed
+/// QSlim edge costs `C_e = P_e + QS_e` of the Face Split block, computed
 /// only where they can change the block's result.
 ///
 /// Only edges with `c_e = C_e < t` can act: `t = τ` for suppression and free collapses,
 /// `t = max S` for swaps (a face f pairs with e only if `S_f > c_e`). The independent
-/// selection (§3.11) of those edges depends only on edges ranked above them (a kept edge
+/// selection of those edges depends only on edges ranked above them (a kept edge
 /// excludes edges within `exclusion_rings − 1` hops, inside the `propagation` hops over which
 /// it was a local maximum, so it never excludes a better-ranked one). Hence an edge whose
 /// cheap lower bound `P_e + min(placement values)` ([`edge_cost_lower_bound`]) proves
@@ -547,12 +556,12 @@ impl EdgeCosts {
 /// Kept edges as `(c_e, e)` sorted by `c_e`, then id.
 type Chosen = Vec<(f64, EdgeId)>;
 
-/// §3.8 steps 4–6 on the edges that can matter below threshold `t` (see [`EdgeCosts`]):
-/// the independent set over the edges with priority `exp(−C_e) ≥ priority_floor(t)`, its
-/// edges with `c_e = max(C_e, P_e) < t` sorted by `(c_e, id)`, and the swap count k of the
-/// pairing with `ranked` (faces by S descending). These agree with the unrestricted
-/// computation (`t = ∞`) on every edge with `c_e < t`. The last value says whether k is also
-/// the unrestricted swap count: yes unless all the returned edges swap and the next face
+/// The block's pairing restricted to the edges that can matter below threshold `t` (see
+/// [`EdgeCosts`]): the independent set over the edges with priority
+/// `exp(−C_e) ≥ priority_floor(t)`, its edges with `c_e = max(C_e, P_e) < t` sorted by `(c_e, id)`,
+/// and the swap count k of the pairing with `ranked` (faces by S descending). These agree with the
+/// unrestricted computation (`t = ∞`) on every edge with `c_e < t`. The last value says whether k
+/// is also the unrestricted swap count: yes unless all the returned edges swap and the next face
 /// scores above `t` (it might pair with an edge that was left out).
 fn pair_edges(
     mesh: &Mesh,
@@ -632,7 +641,7 @@ mod tests {
     use roar_mesh::spatial::corner_angles;
     use roar_mesh::spatial::regular_samples;
 
-    /// The direct reading of §3.5 steps 1–4 (unit normals, `acos` corner angles), the brute-force
+    /// The direct reading of the face score (unit normals, `acos` corner angles), the brute-force
     /// reference of [`grid_score`].
     fn reference_grid_score(
         samples: &RegularSamples,

@@ -1,7 +1,7 @@
 //! QEM decimation to an exact face count (Garland–Heckbert quadric edge collapse), keeping the
 //! mesh a closed, oriented 2-manifold free of new self-intersections.
 //!
-//! The pipeline uses it twice (DESIGN.md §2, spec §3 "working budget" and §6): to bring the
+//! The pipeline uses it twice (`docs/design.md#one-reconstruction`): to bring the
 //! initial mesh to the working budget, and to reach exactly the requested face count N at the
 //! end without introducing self-intersections.
 //!
@@ -61,10 +61,10 @@ pub struct DecimateOptions {
     pub min_normal_dot: f64,
     /// Successive bounds on the aspect ratio `Q = R/(2r)` (1 for an equilateral triangle) of the
     /// faces a collapse creates; the next bound is used only when the previous one blocks the
-    /// budget. Default `[10, 20]`: the brief's steps were 5 → 10 → 20, but with the soft
-    /// `quality_penalty_above` shaping the faces, a hard first bound of 5 only costs fidelity
-    /// (Chamfer/diag decimating to 1000 faces with penalty and planar terms on, bound 5 / 10 /
-    /// 20: roar's 5000-face cgal-non_manifold_face_graph 2.94e-3 / 2.74e-3 / 2.65e-3; the
+    /// budget. Default `[10, 20]`. A first bound of 5 (the collapse blocks' bound) was tried, but
+    /// with the soft `quality_penalty_above` shaping the faces, a hard first bound of 5 only costs
+    /// fidelity (Chamfer/diag decimating to 1000 faces with penalty and planar terms on, bound 5 /
+    /// 10 / 20: roar's 5000-face cgal-non_manifold_face_graph 2.94e-3 / 2.74e-3 / 2.65e-3; the
     /// 5000-face init of manifoldplus-chair 4.05e-3 / 3.45e-3 / 3.40e-3). Each must be ≥ 1.
     pub quality_bounds: Vec<f64>,
     /// Soft preference for well-shaped faces (default 2; 0 turns it off): a collapse whose worst

@@ -32,9 +32,9 @@
 //! collapses create can reach it. (Without that, the grid also held the other half and was never
 //! rebuilt with coarser cells, since the copy's face count never halves.)
 //!
-//! Only the faces next to the plane are frozen: an earlier version kept a band as wide as twice
-//! the longest edge out of both halves (about 5 % of the faces of a large init, all left to the
-//! sequential phase), which the argument above does not need.
+//! Only the faces next to the plane are frozen. A band as wide as twice the longest edge kept out
+//! of both halves would hold about 5 % of the faces of a large init, all left to the sequential
+//! phase, and the argument above does not need it.
 //!
 //! Each side is decimated to its share of twice the target, so the last halving (and the faces
 //! at the cut) is done in the global cheapest-first order. The answer does not depend on the

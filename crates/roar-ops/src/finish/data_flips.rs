@@ -14,9 +14,10 @@
 //!
 //! The four vertices stay; only the diagonal changes, and which diagonal fits a curved surface
 //! depends on the surface: the diagonal that runs along a ridge or a valley keeps both faces on
-//! their slopes, the one across it tilts both. The loop's valence flips (spec §3.7) and the
+//! their slopes, the one across it tilts both. The loop's valence flips and the
 //! tangential smoothing choose diagonals for the triangles' shapes and the final QEM for the
-//! working mesh's quadrics; none looks at the target's normals. [INF] Not in the paper.
+//! working mesh's quadrics; none looks at the target's normals. Not in the paper
+//! (`docs/method.md#finish`).
 //!
 //! The error of a face f with unit normal `n_f` and area `A_f` is
 //! `E(f) = A_f · Σ_s (1 − |n_f · m(s)|) / S` over S = 7 fixed points s of the face (centroid,

@@ -1,7 +1,7 @@
 //! Handle removal: when a face budget is too small for a mesh's genus (or the QEM stalls on the
 //! link condition), cut the mesh along a short non-contractible loop and cap both sides, one
-//! handle at a time (DESIGN.md §2: the finish's documented exception to "every operator keeps
-//! the genus").
+//! handle at a time: the finish's one documented exception to "every operator keeps the genus"
+//! (`docs/design.md#invariants`).
 //!
 //! **Which loop.** For a few root vertices spread over the mesh, a shortest-path tree `T` from
 //! the root and a spanning tree `C` of the dual graph that crosses no edge of `T` (built from
@@ -31,9 +31,9 @@ use std::cmp::Reverse;
 use std::collections::BinaryHeap;
 use thiserror::Error;
 
-/// The smallest face budget the finish can always reach for a mesh of `pieces` separate
-/// pieces: a tetrahedron each (4 faces), once handles may be removed. Separate parts of the
-/// input stay separate (DESIGN.md §2), so no budget below this is reachable.
+/// The smallest face budget the finish can always reach for a mesh of `pieces` separate pieces: a
+/// tetrahedron each (4 faces), once handles may be removed. Separate parts of the input stay
+/// separate (a design rule: `docs/design.md#invariants`), so no budget below this is reachable.
 pub fn min_reachable_budget(pieces: usize) -> usize {
     4 * pieces
 }

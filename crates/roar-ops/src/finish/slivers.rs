@@ -45,7 +45,7 @@ pub struct SliverOptions {
     /// Faces with `Q` above this are slivers. Default 10 (the QEM's second quality bound).
     pub max_quality: f64,
     /// Only edges whose two faces have `|n_L · n_R| ≥` this are flipped. Default 0.95 (the gate
-    /// of the valence flips, spec §3.7).
+    /// of the valence flips).
     pub min_abs_flatness: f64,
     /// A face with `Q` at or above this is degenerate: its normal is not trusted, and the flat
     /// test looks at the other face only (module doc, test 2). Default 100, the QEM's

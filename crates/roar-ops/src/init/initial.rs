@@ -1,4 +1,5 @@
-//! The pipeline's initial mesh (spec §4.1: watertight init, then QEM to at most 20k faces).
+//! The pipeline's initial mesh: the watertight init, then QEM to at most 20k faces, as the authors
+//! simplify Manifold's output (`docs/method.md#watertight-init`).
 
 use super::{InitError, InitOptions, InitStats, WatertightInit, watertight_init};
 use crate::decimate::{DecimateOptions, DecimateStats, decimate_in_parallel, minimum_faces};
@@ -11,7 +12,8 @@ use std::time::Instant;
 pub struct InitialMeshOptions {
     /// Options of the watertight init (step 1).
     pub init: InitOptions,
-    /// Largest face count of the result (spec §4.1: the init is decimated to ≤ 20k faces).
+    /// Largest face count of the result (20k in the pipeline, the authors'
+    /// configuration's `init_num_faces`).
     pub max_faces: usize,
     /// Options of the QEM decimation (step 2); `best_effort` is always switched on, so reaching
     /// fewer faces than asked never fails.

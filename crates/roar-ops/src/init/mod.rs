@@ -1,4 +1,5 @@
-//! Watertight initial meshes (spec §4.1, §4.3; DESIGN.md §2 "Pieces").
+//! Watertight initial meshes, in the manner of Manifold, which the paper starts from
+//! (`docs/method.md#watertight-init`).
 //!
 //! [`watertight_init`] turns any triangle soup into a closed, outward-oriented, 2-manifold triangle
 //! mesh in the manner of Manifold (Huang et al. 2018):
@@ -21,7 +22,7 @@
 //! 5. split into pieces and drop pieces under 0.1 % of the total area.
 //!
 //! [`sdf_init`] builds the same kind of mesh from the negative cells of a signed distance function
-//! (spec §4.3), through the same repair and extraction code.
+//! (supplementary §3), through the same repair and extraction code.
 
 mod grid;
 mod initial;
@@ -45,8 +46,9 @@ use thiserror::Error;
 /// Options of [`watertight_init`]. Lengths are in voxels.
 #[derive(Clone, Debug, PartialEq)]
 pub struct InitOptions {
-    /// Voxels along the longest bounding-box axis (brief default 128; Manifold's octree
-    /// "resolution 10000" of spec §4.1 / OQ-12 is about 100 voxels per axis on a compact shape).
+    /// Voxels along the longest bounding-box axis (default 128, `roar init`'s; the pipeline
+    /// uses 192). The authors run Manifold at octree "resolution 10000", about 100 voxels per
+    /// axis on a compact shape (`docs/method.md#decision-voxel-init-instead-of-manifold`).
     pub resolution: usize,
     /// Empty voxels added on each side of the bounding box (at least 2).
     pub padding: usize,
@@ -72,14 +74,13 @@ pub struct InitOptions {
     /// Fold guard: a move is rejected if two edge-adjacent triangles around the vertex get unit
     /// normals with a dot product below this (-0.5: dihedral fold beyond 120°).
     pub min_dihedral_dot: f64,
-    /// Pieces with less than this fraction of the total area are dropped (DESIGN.md §2: 0.1 %).
+    /// Pieces with less than this fraction of the total area are dropped (default 0.1 %).
     pub min_piece_area_fraction: f64,
     /// Safety cap on the passes of the manifold repair.
     pub max_repair_passes: usize,
     /// Exterior voxels whose centre has a generalized winding number (of the soup) above this
     /// turn solid, so punctures of closed surfaces close while real tunnels stay (module
-    /// `winding_solid`, which says how it was measured; spec OQ-14 puts the reference code's
-    /// value at 0.48, applied where is not known). Default [`ENCLOSURE_WINDING_THRESHOLD`];
+    /// `winding_solid`, which says how it was measured). Default [`ENCLOSURE_WINDING_THRESHOLD`];
     /// `None` keeps the flood fill alone. Must be at least ½, so that one flat open sheet
     /// (|w| < ½) never fills. Not the point-cloud filter's `winding_threshold`.
     pub enclosure_winding_threshold: Option<f64>,
@@ -126,12 +127,13 @@ pub const ENCLOSURE_WINDING_THRESHOLD: f64 = 0.7;
 /// base, gpytoolbox-airplane's gaps) and 7 % on an open surface (libigl-camelhead's neck).
 pub const ENCLOSURE_MAX_CAP_FRACTION: f64 = 0.02;
 
-/// Options of [`sdf_init`] (spec §4.3: a 64³ grid over the bounding cube).
+/// Options of [`sdf_init`] (supplementary §3: a 64³ grid over the bounding cube).
 #[derive(Clone, Debug, PartialEq)]
 pub struct SdfInitOptions {
-    /// Cells along the longest axis of the bounds (spec §4.3: 64).
+    /// Cells along the longest axis of the bounds (supplementary §3: 64).
     pub resolution: usize,
-    /// Pieces with less than this fraction of the total area are dropped (DESIGN.md §2: 0.1 %).
+    /// Pieces with less than this fraction of the total area are dropped (default 0.1 %, as
+    /// for soups).
     pub min_piece_area_fraction: f64,
     /// Safety cap on the passes of the manifold repair.
     pub max_repair_passes: usize,
@@ -513,9 +515,9 @@ fn watertight_init_from(
 }
 
 /// Builds a closed, outward-oriented 2-manifold from the cells of a grid over
-/// `[bounds_min, bounds_max]` whose centre has `sdf < 0` (spec §4.3), with the same manifold repair
-/// and boundary extraction as [`watertight_init`]. Interior voids are filled (the exterior is the
-/// region connected to the border). Vertices stay on the grid corners. The cell centres are
+/// `[bounds_min, bounds_max]` whose centre has `sdf < 0` (supplementary §3), with the same manifold
+/// repair and boundary extraction as [`watertight_init`]. Interior voids are filled (the exterior
+/// is the region connected to the border). Vertices stay on the grid corners. The cell centres are
 /// evaluated in one batch of values ([`Sdf::values`]; no gradients); a NaN counts as outside.
 pub fn sdf_init(
     sdf: &dyn Sdf,

@@ -2,14 +2,15 @@
 //! the dilation layer, and the repair that removes every voxel configuration whose boundary would
 //! be non-manifold.
 //!
-//! **Choice (documented per the brief):** instead of splitting non-manifold vertices and edges of
+//! **Choice:** instead of splitting non-manifold vertices and edges of
 //! the voxel surface and offsetting the copies, non-manifold configurations are *removed from the
 //! voxel set* by adding exterior voxels to the solid until none remains. Two solid voxels touching
 //! only along an edge (a "checkerboard" edge) get one of the two exterior voxels of that edge; a
 //! grid corner whose eight voxels do not split into one face-connected solid part and one
 //! face-connected exterior part gets all of its exterior voxels. After each pass the exterior is
 //! flood-filled again, so it stays one face-connected region and the solid never has cavities.
-//! Why: (a) it matches the pieces rule of DESIGN.md §2 (touching parts merge into one piece), (b)
+//! Why: (a) it matches the pieces rule (touching parts merge into one piece;
+//! `docs/method.md#watertight-init`), (b)
 //! the surface then uses each grid corner once, so no coincident duplicated vertices exist that the
 //! projection step or later self-intersection checks would have to keep apart, and (c) the
 //! guarantee is local and checkable: the boundary of a voxel set is a 2-manifold iff no edge is a

@@ -1,4 +1,4 @@
-//! Step 1 and the dilation of step 2 (spec §4, brief "watertight init"): mark every voxel a
+//! Step 1 and the dilation of step 2 of the watertight init (module docs): mark every voxel a
 //! triangle touches, with the exact triangle–box overlap test of Akenine-Möller (separating axes).
 
 use super::grid::Grid;

@@ -1,7 +1,7 @@
 //! Vertex 1-rings built from a plain triangle list (compressed sparse rows).
 //!
 //! The optimizer needs, per vertex, its unique 1-ring neighbours (for the uniform Laplacian
-//! δ_v and the shortest incident edge ℓ_v, spec §2.2 and §3.2.4). The mesh changes topology
+//! δ_v and the shortest incident edge ℓ_v). The mesh changes topology
 //! between steps, so the rings are rebuilt every step; the rebuild is O(V + F) (plus sorting
 //! each ring, whose length is the valence) and reuses its buffers, so it allocates nothing once
 //! the buffers have reached the mesh's size.

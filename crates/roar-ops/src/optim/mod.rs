@@ -1,4 +1,5 @@
-//! The Move Vertices optimizer (spec §3.2.4): a VectorAdam-like step whose size follows the
+//! The Move Vertices optimizer (paper §3.1; the exact step is the authors' code's,
+//! `docs/method.md#optimizer`): a VectorAdam-like step whose size follows the
 //! local edge length, with a Laplacian term added in gradient space.
 //!
 //! The optimizer works on plain buffers: positions `&mut [DVec3]`, per-vertex gradients
@@ -8,14 +9,14 @@
 //! [`roar_mesh::VertexStore`], so every operator and compaction made through a
 //! [`roar_mesh::TrackedMesh`] over it calls the matching transfer method
 //! ([`Optimizer::on_collapse`], [`Optimizer::on_edge_split`], [`Optimizer::on_face_split`],
-//! [`Optimizer::grow`], [`Optimizer::apply_remap`]; spec §3.12).
+//! [`Optimizer::grow`], [`Optimizer::apply_remap`]).
 //!
 //! One step, for every live vertex v (a vertex referenced by at least one triangle), with the
 //! global step counter t = 1, 2, … that remeshing never resets:
 //!
 //! ```text
 //! g   = ∂L/∂v (non-finite → 0) + w_lap · ν_v · δ_v        δ_v = v − mean of the 1-ring
-//! if t > 1: g clamped per component to ±grad_lim·|m1|    (only where m1 ≠ 0, note 6)
+//! if t > 1: g clamped per component to ±grad_lim·|m1|    (only where m1 ≠ 0, see below)
 //! m1  = ulerp(m1, g, β1, t);   m2 = ulerp(m2, ‖g‖², β2, t)
 //! u   = m1 / (√m2 + 1e-8);     ν  = ulerp(ν, ‖u‖, β3, t)
 //! ℓ_v = min(shortest incident edge, edge_len_max)
@@ -51,40 +52,41 @@ use rayon::prelude::*;
 use std::ops::{Add, Mul};
 
 /// Added to √m2 before dividing, so a vertex with zero gradient history does not divide by
-/// zero (spec §3.2.4, `eps = 1e-8`).
+/// zero (the authors' `eps = 1e-8`).
 pub const VELOCITY_EPSILON: f64 = 1e-8;
 
 /// Vertices per work unit. The per-step reductions (mean move, …) sum per-chunk partials in
 /// chunk order, so results are bit-identical whether the chunks run in parallel or not.
 const CHUNK: usize = 4096;
 
-/// Hyper-parameters of the optimizer. `Default` carries the spec's values (§3.2.4, master
-/// table §8, column "use").
+/// Hyper-parameters of the optimizer. `Default` carries the paper's learning rate
+/// (supplementary §1) and the authors' code's other values.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct OptimizerOptions {
-    /// Learning rate η (§8 `lr`: 0.05). The typical move per step is about η·ℓ_v.
+    /// Learning rate η (0.05, supplementary §1). The typical move per step is about η·ℓ_v.
     pub lr: f64,
-    /// (β1, β2, β3) (§8 `betas`: 0.8, 0.8, 0): EMA factors of the first moment m1, of the
+    /// (β1, β2, β3) (0.8, 0.8, 0): EMA factors of the first moment m1, of the
     /// second moment m2 and of the speed ν. Each must lie in [0, 1); β3 = 0 means ν = ‖u‖.
     pub betas: (f64, f64, f64),
     /// Weight w_lap of the uniform Laplacian added to the gradient, scaled by ν
-    /// (§3.2.4, §8 `laplacian_weight`: 0.02).
+    /// (0.02).
     pub laplacian_weight: f64,
-    /// Learning-rate warm-up: η_t = η·min(1, t(1−β1)/ramp) (§8 `ramp`: 1, full rate after 5
+    /// Learning-rate warm-up: η_t = η·min(1, t(1−β1)/ramp) (1: full rate after 5
     /// steps). Must be > 0.
     pub ramp: f64,
     /// From the second step on, each gradient component is clamped to ±grad_lim·|m1|
-    /// (§8 `grad_lim`: 10). Must be > 0; `f64::INFINITY` disables clamping.
+    /// (10). Must be > 0; `f64::INFINITY` disables clamping.
     pub grad_lim: f64,
     /// Cap of the reference length ℓ_v = min(shortest incident edge, edge_len_max)
-    /// (§3.2.4, §8 `edge_len_lims[1]`: 0.15). Must be > 0; `f64::INFINITY` removes the cap.
+    /// (0.15). Must be > 0; `f64::INFINITY` removes the cap.
     pub edge_len_max: f64,
-    /// Verification note 6: clamp a gradient component only where its |m1| > 0. With `false`
-    /// the reference behaviour is kept, which freezes forever a component whose first gradient
-    /// was exactly 0 (its bound is ±10·0). Default `true`.
+    /// Clamp a gradient component only where its |m1| > 0
+    /// (`docs/method.md#decision-gradient-clamp`). With `false` the authors' behaviour is kept,
+    /// which freezes forever a component whose first gradient was exactly 0 (its bound is ±10·0).
+    /// Default `true`.
     pub clamp_only_nonzero_m1: bool,
-    /// Use rayon for the per-vertex passes from this many vertices on (not a spec parameter;
-    /// default 50 000). Results are bit-identical either way.
+    /// Use rayon for the per-vertex passes from this many vertices on (not a parameter of the
+    /// method; default 50 000). Results are bit-identical either way.
     pub parallel_min_vertices: usize,
 }
 
@@ -212,7 +214,8 @@ pub enum OptimError {
     },
 }
 
-/// The optimizer state of one vertex (spec §2.1: m1, m2, ν travel with the vertex).
+/// The optimizer state of one vertex: m1, m2 and ν, which travel with the vertex through every
+/// topology change.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct VertexState {
     /// First moment: bias-corrected EMA of the gradient (3-vector).
@@ -233,7 +236,7 @@ impl VertexState {
         }
     }
 
-    /// The mean of three rows (the new vertex of a 1→3 face split, spec §3.12).
+    /// The mean of three rows (the new vertex of a 1→3 face split).
     pub fn mean3(a: &Self, b: &Self, c: &Self) -> Self {
         let third = 1.0 / 3.0;
         Self {
@@ -244,9 +247,9 @@ impl VertexState {
     }
 }
 
-/// The weights `(a_weight, b_weight)` of the bias-corrected EMA at step `t ≥ 1`
-/// (spec §3.2.4): with `c_t = 1 − β^t`, `a_weight = β·c_{t−1}/c_t`, `b_weight = (1−β)/c_t`.
-/// At t = 1, `a_weight = 0` and `b_weight = 1`. `t = 0` is treated as t = 1.
+/// The weights `(a_weight, b_weight)` of the bias-corrected EMA at step `t ≥ 1` (as in the authors'
+/// code): with `c_t = 1 − β^t`, `a_weight = β·c_{t−1}/c_t`, `b_weight = (1−β)/c_t`. At t = 1,
+/// `a_weight = 0` and `b_weight = 1`. `t = 0` is treated as t = 1.
 pub fn ulerp_weights(beta: f64, t: u64) -> (f64, f64) {
     let t = t.clamp(1, i32::MAX as u64) as i32;
     let c_prev = 1.0 - beta.powi(t - 1);
@@ -286,7 +289,7 @@ pub struct StepStats {
     pub nonfinite_components: usize,
 }
 
-/// The per-vertex optimizer of spec §3.2.4, with its state rows and a global step counter.
+/// The per-vertex Move Vertices optimizer, with its state rows and a global step counter.
 ///
 /// Contract with the pipeline: row `i` belongs to vertex id `i` of the arrays passed to
 /// [`Optimizer::step`]. Whenever the mesh's vertex set changes, the matching transfer method
@@ -394,7 +397,7 @@ impl Optimizer {
         self.state.is_empty()
     }
 
-    /// Takes one optimizer step (spec §3.2.4), moving `positions` in place and updating the
+    /// Takes one optimizer step (module docs), moving `positions` in place and updating the
     /// state rows of every live vertex. Vertices referenced by no triangle are dead: their
     /// position and row are left alone.
     ///
@@ -575,7 +578,7 @@ fn finite_or_zero(g: DVec3, count: &mut usize) -> DVec3 {
     DVec3::new(fix(g.x, count), fix(g.y, count), fix(g.z, count))
 }
 
-/// The update of one live vertex (spec §3.2.4).
+/// The update of one live vertex (module docs).
 fn update_vertex(
     position: &mut DVec3,
     s: &mut VertexState,

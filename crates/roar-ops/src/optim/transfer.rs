@@ -1,10 +1,11 @@
-//! Keeping the optimizer rows in step with the mesh through topology changes (spec §3.12).
+//! Keeping the optimizer rows in step with the mesh through topology changes: a
+//! vertex's optimizer state travels with it, as in the authors' code.
 //!
 //! The optimizer is a [`VertexStore`]: edit the mesh through a [`TrackedMesh`] over it and
 //! every operator and compaction forwards its outcome record here, so no caller can forget a
 //! transfer. The rows never hold positions, so these methods only touch m1, m2 and ν. Flips
 //! change no vertex, so they need no call. The step counter is never touched: t is global and
-//! remeshing does not reset it (§3.2.4).
+//! remeshing does not reset it.
 //!
 //! | mesh event | store call | transfer |
 //! |---|---|---|
@@ -66,7 +67,7 @@ impl VertexStore for Optimizer {
 }
 
 impl Optimizer {
-    /// Edge collapse (spec §3.12): the survivor's row becomes the row of `row_source`, the
+    /// Edge collapse: the survivor's row becomes the row of `row_source`, the
     /// endpoint whose placement was chosen (α ∈ {0, 1}). Pass `row_source == survivor` when
     /// the survivor kept its own position (then nothing changes), or the removed endpoint's id
     /// when the survivor moved to the removed endpoint's position. The removed row is left as
@@ -90,7 +91,7 @@ impl Optimizer {
         self.set_new_row("on_edge_split", new_vertex, VertexState::lerp(&a, &b, t))
     }
 
-    /// Face split 1→3 (spec §3.12): the new (centroid) vertex gets the mean of the three corner
+    /// Face split 1→3: the new (centroid) vertex gets the mean of the three corner
     /// rows. `new_vertex` must be `len()` (appended) or an existing row (overwritten).
     pub fn on_face_split(&mut self, new_vertex: u32, parents: [u32; 3]) -> Result<(), OptimError> {
         let a = *self.row("on_face_split", parents[0])?;

@@ -1,7 +1,7 @@
 //! Untangle: remove every self-intersection of a closed mesh, and a step limiter that keeps the
 //! optimizer from creating new ones.
 //!
-//! The Face Collapse block (spec §3.6) only sees local folds; two distant sheets crossing each
+//! The Face Collapse block only sees local folds; two distant sheets crossing each
 //! other slip through it, yet the output promises zero self-intersections. [`untangle`] finds
 //! every intersecting face pair ([`intersecting_pairs`], BVH + exact test) and resolves them in
 //! rounds. The idea: a closed oriented mesh without intersections has winding number 1 just

@@ -7,7 +7,7 @@ use roar_mesh::spatial::{Aabb, TriangleBvh, closest_point_on_triangle};
 use std::collections::BTreeSet;
 
 /// Squared distance between segments `p0p1` and `q0q1` (Ericson, Real-Time Collision
-/// Detection §5.1.9).
+/// Detection, section 5.1.9).
 fn segment_distance_squared(p0: DVec3, p1: DVec3, q0: DVec3, q1: DVec3) -> f64 {
     let (d1, d2, r) = (p1 - p0, q1 - q0, p0 - q0);
     let (a, e, f) = (d1.length_squared(), d2.length_squared(), d2.dot(r));

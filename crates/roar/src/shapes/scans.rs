@@ -4,7 +4,7 @@
 //! [`load_scans`] turns every scan into its patch (`roar_io::RangeGrid::patch` for range images,
 //! `roar_io::point_scan_patch` for points alone), places
 //! the patches by the `.conf` poses and refines the poses by ICP (`roar_ops::align`). The union
-//! of the aligned patches, holes and overlaps included, is the target: a [`crate::pipeline::SoupShape`]
+//! of the aligned patches, holes and overlaps included, is the target: a [`crate::SoupShape`]
 //! of it, with the scan defaults' enclosure rule (`ReconstructConfig::scan_defaults`), since a
 //! scanned object is closed but the scanner never sees all of it (the bunny's base), and the
 //! scanners' lines of sight ([`AlignedScans::scanner_views`]), which close what the scanners

@@ -1,12 +1,12 @@
-//! A signed distance function as a [`Shape`] (spec §5): the input kind `roar reconstruct` reads
-//! from `.npz` and `.safetensors` networks, `.sdf.toml` files and `.npy` grids (`roar_sdf`).
+//! A signed distance function as a [`Shape`] (`docs/sdf.md`): the input kind `roar reconstruct`
+//! reads from `.npz` and `.safetensors` networks, `.sdf.toml` files and `.npy` grids (`roar_sdf`).
 //!
-//! In rig coordinates (the bounds' centre at the origin, their corners on the rig's sphere):
-//! the target renders are traced normal maps of the zero set (`roar_sdf::trace`); the initial
-//! mesh is the voxel init of `f < 0` on a `sdf_init_resolution` grid over the bounds (spec
-//! §4.3), decimated to `init_max_faces`; the point cloud is samples of that init projected onto
-//! the zero set along the gradient; the Face Split projector is spec §3.4 C; and the shape
-//! offers its field to the SDF loss.
+//! In rig coordinates (the bounds' centre at the origin, their corners on the rig's sphere): the
+//! target renders are traced normal maps of the zero set (`roar_sdf::trace`); the initial mesh is
+//! the voxel init of `f < 0` on a `sdf_init_resolution` grid over the bounds (supplementary §3),
+//! decimated to `init_max_faces`; the point cloud is samples of that init projected onto the zero
+//! set along the gradient; the Face Split projector steps along each sample's normal onto the zero
+//! set (`roar_sdf::SdfProjector`); and the shape offers its field to the SDF loss.
 
 use std::borrow::Cow;
 use std::collections::BTreeMap;
@@ -270,7 +270,7 @@ impl Shape for SdfShape {
         Some(self.rig.clone())
     }
 
-    /// The field's projector (spec §3.4 C) unless `sdf_split_projector` is off.
+    /// The field's projector ([`SdfProjector`]) unless `sdf_split_projector` is off.
     fn projector(&self) -> Option<&dyn Projector> {
         self.config
             .optimize

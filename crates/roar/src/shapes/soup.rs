@@ -4,7 +4,8 @@
 //! [`SoupShape::prepare`] builds the cleaned target T′ (weld, normalize, twin clean-up by pixel
 //! counts; `roar_loss::target`) and its renders; the initial mesh is the watertight voxel init
 //! of T′ decimated to `init_max_faces` (`roar_ops::init`); the point cloud is the
-//! winding-filtered samples of T′ plus samples on the sharp edges of M0 (spec §3.1 b, c).
+//! winding-filtered samples of T′ plus samples on the sharp edges of M0
+//! (`docs/method.md#point-cloud`).
 
 use std::borrow::Cow;
 

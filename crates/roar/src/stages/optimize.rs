@@ -1,5 +1,5 @@
-//! The optimize stage (spec §1.2, §3.2): the objective from what the shape gave, then the loop
-//! of Move Vertices steps and scheduled blocks, keeping a checkpoint state every
+//! The optimize stage (`docs/method.md#the-loop`): the objective from what the shape gave, then the
+//! loop of Move Vertices steps and scheduled blocks, keeping a checkpoint state every
 //! `checkpoint_interval` iterations and the last state, each with its loss, for the finish.
 
 use std::borrow::Cow;
@@ -228,7 +228,7 @@ pub(crate) fn new_optimizer(
     .map_err(|e| PipelineError::Config(e.to_string()))
 }
 
-/// One Move Vertices step (spec §3.2.4): the loss and its gradient on the compacted mesh, the
+/// One Move Vertices step (paper §3.1): the loss and its gradient on the compacted mesh, the
 /// optimizer step, then the step limiter if configured. Stage times go to `{stage}_loss`,
 /// `{stage}_step` and `{stage}_step_limiter`. Returns the loss before the step.
 pub(crate) fn move_vertices(
