@@ -22,20 +22,32 @@
 //! gave, and [`Reconstruction::blocks`] is the remeshing schedule (any
 //! [`roar_ops::blocks::block::Block`]).
 //!
-//! ```no_run
+//! ```
 //! use roar::{ReconstructConfig, Reconstruction};
 //!
 //! let soup = roar::example::chair_soup();
-//! let config = ReconstructConfig { faces: 1000, ..ReconstructConfig::default() };
+//! // `ReconstructConfig::default()` is the full schedule; this is a quick, coarse one.
+//! let mut config = ReconstructConfig { faces: 600, ..ReconstructConfig::default() };
+//! config.target.views_per_axis = 2;
+//! config.target.render_resolution = 64;
+//! config.target.point_cloud_samples = 5000;
+//! config.init.init_resolution = 32;
+//! config.loss.render_coarse_resolution = 32;
+//! config.optimize.iterations = 4;
+//! config.optimize.working_budget_min = 600;
 //! let output = Reconstruction::new(config)
 //!     .run_soup(&soup.positions, &soup.triangles, &mut |_| {})
 //!     .expect("the example soup reconstructs");
-//! assert_eq!(output.triangles.len(), 1000);
+//! assert_eq!(output.triangles.len(), 600);
 //! ```
 //!
-//! Modules depend only on the ones listed before them: errors, configuration, the report and
-//! the run state at the bottom; the input kinds and the stages above them; [`Reconstruction`]
-//! on top.
+//! Imports point down (`scripts/module-cycles.py` checks it):
+//! - bottom: [`error`], [`shape`] (the seam), [`budget`], [`config`], [`report`], [`run`] (the
+//!   state a run shares), [`rig`], [`objective`] (the loss factory), [`schedule`] (the blocks),
+//!   [`input`] and [`example`];
+//! - above them: [`shapes`] (soups, signed distances, scan sets) and the stages
+//!   (`prepare`, `init`, `optimize`, `finish`);
+//! - on top: [`reconstruction`], the stages in order.
 
 pub mod budget;
 pub mod config;
