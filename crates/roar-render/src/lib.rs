@@ -25,18 +25,18 @@
 
 pub mod antialias;
 pub mod camera;
+mod draw;
 pub mod loss;
 pub mod normals;
-mod pipeline;
 pub mod raster;
 pub mod topology;
 
 pub use antialias::AaItem;
 pub use camera::{Camera, star_cameras};
-pub use loss::{LossKind, image_loss};
-pub use pipeline::{
+pub use draw::{
     Image, Renders, ViewRender, backward, face_pixel_counts, render, render_loss_and_grad, to_rgba8,
 };
+pub use loss::{LossKind, image_loss};
 
 /// Triangle id stored in pixels that no triangle covers.
 pub const BACKGROUND: u32 = u32::MAX;
