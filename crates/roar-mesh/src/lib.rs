@@ -43,6 +43,7 @@ pub use compact::Remap;
 pub use error::{BuildError, Element, MeshError, TopoError, ValidationError};
 pub use glam::DVec3;
 pub use handles::{EdgeId, FaceId, HalfedgeId, VertexId};
-pub use mesh::{DEGENERATE_CROSS, DEGENERATE_NORMAL, Mesh};
+pub use mesh::Mesh;
 pub use ops::{Collapse, EdgeSplit, FaceSplit};
+pub use spatial::triangle::{DEGENERATE_CROSS, DEGENERATE_NORMAL};
 pub use tracked::{NoStore, TrackedMesh, VertexStore};

@@ -1,16 +1,11 @@
 //! The [`Mesh`] type: storage, navigation, live-element iteration and per-element geometry.
 
 use crate::handles::{EdgeId, FaceId, HalfedgeId, VertexId};
+use crate::spatial::triangle::DEGENERATE_CROSS;
 use glam::DVec3;
 
 /// Raw-array sentinel for "no element"; never exposed by the public API.
 pub(crate) const INVALID: u32 = u32::MAX;
-
-/// Faces with `|cross| <= DEGENERATE_CROSS` get the default normal and clamped area (spec §2.2).
-pub const DEGENERATE_CROSS: f64 = 1e-9;
-
-/// Normal of a degenerate face (spec §2.2).
-pub const DEGENERATE_NORMAL: DVec3 = DVec3::X;
 
 /// A closed, oriented, 2-manifold triangle mesh in half-edge form.
 ///
