@@ -1,6 +1,9 @@
 //! The pipeline's initial mesh (spec §4.1: watertight init, then QEM to at most 20k faces).
 
-use super::{InitError, InitOptions, InitStats, WatertightInit, watertight_init};
+use super::error::InitError;
+use super::options::InitOptions;
+use super::output::{InitStats, WatertightInit};
+use super::watertight::watertight_init;
 use crate::decimate::{DecimateOptions, DecimateStats, decimate_in_parallel, minimum_faces};
 use glam::DVec3;
 use roar_mesh::Mesh;
