@@ -36,6 +36,7 @@ pub mod shapes;
 pub mod spatial;
 mod topology;
 mod tracked;
+mod triangle;
 mod validate;
 
 pub use circulators::{FacesAround, Neighbors, Outgoing};
@@ -45,5 +46,5 @@ pub use glam::DVec3;
 pub use handles::{EdgeId, FaceId, HalfedgeId, VertexId};
 pub use mesh::Mesh;
 pub use ops::{Collapse, EdgeSplit, FaceSplit};
-pub use spatial::triangle::{DEGENERATE_CROSS, DEGENERATE_NORMAL};
 pub use tracked::{NoStore, TrackedMesh, VertexStore};
+pub use triangle::{DEGENERATE_CROSS, DEGENERATE_NORMAL};

@@ -1,7 +1,7 @@
 //! The [`Mesh`] type: storage, navigation, live-element iteration and per-element geometry.
 
 use crate::handles::{EdgeId, FaceId, HalfedgeId, VertexId};
-use crate::spatial::triangle::DEGENERATE_CROSS;
+use crate::triangle::DEGENERATE_CROSS;
 use glam::DVec3;
 
 /// Raw-array sentinel for "no element"; never exposed by the public API.
@@ -258,7 +258,7 @@ impl Mesh {
     /// Unit normal of `f`; faces with `|cross| <= 1e-9` get `(1, 0, 0)` (spec §2.2).
     pub fn face_normal(&self, f: FaceId) -> DVec3 {
         let [a, b, c] = self.face_vertices(f).map(|v| self.position(v));
-        crate::spatial::triangle_normal(a, b, c)
+        crate::triangle::triangle_normal(a, b, c)
     }
 
     /// Area of `f`, clamped below at `1e-9` as in spec §2.2.
