@@ -16,6 +16,7 @@
 //!   and the paper's ε-offset variant (supplementary §1.1).
 //! - [`evaluate`] gathers everything in a serde [`Report`].
 
+mod error;
 mod fidelity;
 mod nearest;
 mod quality;
@@ -23,6 +24,7 @@ mod report;
 mod self_intersections;
 mod topology;
 
+pub use error::EvalError;
 pub use fidelity::{ChamferOptions, FidelityStats, bbox_diagonal, fidelity};
 pub use nearest::{Nearest, nearest_neighbours};
 pub use quality::{QualityStats, aspect_ratio, triangle_quality};
@@ -32,30 +34,3 @@ pub use self_intersections::{
     self_intersections,
 };
 pub use topology::{TopologyStats, signed_volume, topology, weld_bit_identical};
-
-/// Why a soup cannot be evaluated.
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
-pub enum EvalError {
-    /// A triangle refers to a vertex that does not exist.
-    #[error(
-        "{mesh}: triangle {face} refers to vertex {index}, but there are only {vertices} vertices"
-    )]
-    IndexOutOfRange {
-        /// Which input: "mesh" or "reference".
-        mesh: &'static str,
-        /// Triangle index.
-        face: usize,
-        /// The offending vertex index.
-        index: u32,
-        /// Number of vertices.
-        vertices: usize,
-    },
-    /// A vertex has a NaN or infinite coordinate.
-    #[error("{mesh}: vertex {vertex} has a non-finite coordinate")]
-    NonFinite {
-        /// Which input: "mesh" or "reference".
-        mesh: &'static str,
-        /// Vertex index.
-        vertex: usize,
-    },
-}

@@ -3,7 +3,7 @@
 use glam::DVec3;
 use serde::Serialize;
 
-use crate::EvalError;
+use crate::error::EvalError;
 use crate::fidelity::{ChamferOptions, FidelityStats, fidelity};
 use crate::quality::{QualityStats, triangle_quality};
 use crate::self_intersections::{

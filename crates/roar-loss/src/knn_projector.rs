@@ -13,7 +13,7 @@ use glam::DVec3;
 use rayon::prelude::*;
 use roar_mesh::spatial::Projector;
 
-use crate::LossError;
+use crate::error::LossError;
 use crate::point_tree::{Neighbours, PointTree};
 
 /// Samples per parallel work item (coarse: the machine has few cores).

@@ -5,21 +5,23 @@
 //! (`docs/method.md#render-loss` and the sections after it), behind the common [`Loss`] trait so a
 //! researcher can add or swap a term without touching the pipeline.
 
+mod error;
 pub mod knn_projector;
+mod loss;
 pub mod planar;
 mod point_tree;
 
+pub use error::LossError;
 pub use knn_projector::{KnnOptions, KnnPlanarProjector, PlanarMode};
+pub use loss::Loss;
 pub use planar::{PlanarLoss, PlanarOptions, PlanarStats};
-
-use glam::DVec3;
-use rayon::prelude::*;
 
 pub mod point_cloud;
 pub mod render_loss;
 pub mod sdf_loss;
 pub mod sharp_edges;
 pub mod target;
+mod weighted_sum;
 
 pub use point_cloud::{
     PointCloud, PointCloudOptions, point_cloud, point_cloud_of_soup, two_sided_faces,
@@ -29,179 +31,4 @@ pub use roar_mesh::spatial::{Sdf, SdfEvaluations};
 pub use sdf_loss::{SdfLoss, SdfLossOptions};
 pub use sharp_edges::{SharpEdge, SharpEdgeOptions, sharp_edge_samples, sharp_edges};
 pub use target::{Target, TargetOptions, TargetStats, build_target, render_views};
-
-/// Why a loss could not be evaluated.
-#[derive(Debug, thiserror::Error)]
-pub enum LossError {
-    /// The renderer refused the mesh (e.g. a vertex behind the near plane).
-    #[error("render: {0}")]
-    Render(#[from] roar_render::RenderError),
-    /// The source mesh buffers are unusable (out-of-range index, non-finite position, …).
-    #[error("invalid source mesh: {0}")]
-    InvalidMesh(String),
-    /// The target is unusable (no area, no points, …).
-    #[error("invalid target: {0}")]
-    InvalidTarget(String),
-}
-
-/// A differentiable term of the objective, evaluated on the current source mesh.
-///
-/// Contract: `positions` and `triangles` are a compact closed mesh (every vertex referenced);
-/// the returned gradient has one entry per position. `&mut self` lets a loss keep per-iteration
-/// state (a seeded sample generator, caches); the result must be deterministic for a given call
-/// sequence.
-pub trait Loss: Send {
-    /// Short name for reports and progress lines (e.g. `"render"`, `"planar"`).
-    fn name(&self) -> &'static str;
-    /// The loss value and its gradient with respect to every vertex position.
-    fn value_and_grad(
-        &mut self,
-        positions: &[DVec3],
-        triangles: &[[u32; 3]],
-    ) -> Result<(f64, Vec<DVec3>), LossError>;
-
-    /// The weighted value of each term of the last evaluation, by name, for reports (a loss
-    /// made of one term returns nothing: its value is the total).
-    fn last_terms(&self) -> Vec<(&'static str, f64)> {
-        Vec::new()
-    }
-
-    /// Tells the loss which iteration of the loop the next evaluations belong to (a term that
-    /// switches on late, like the SDF loss, reads it; the finish passes the loop's iteration
-    /// count). The default ignores it.
-    fn set_iteration(&mut self, iteration: usize) {
-        let _ = iteration;
-    }
-}
-
-/// A weighted sum of losses, itself a [`Loss`] (the paper's objective is `3·L_render + 1·L_planar`,
-/// supplementary §1).
-#[derive(Default)]
-pub struct WeightedSum {
-    /// The terms and their weights; evaluated concurrently, summed in this order.
-    pub terms: Vec<(f64, Box<dyn Loss>)>,
-    /// The last evaluation's weighted value of each term (for reports), in term order.
-    pub last_values: Vec<f64>,
-}
-
-impl WeightedSum {
-    /// Adds a term with its weight.
-    pub fn with(mut self, weight: f64, loss: Box<dyn Loss>) -> Self {
-        self.terms.push((weight, loss));
-        self
-    }
-}
-
-impl Loss for WeightedSum {
-    fn name(&self) -> &'static str {
-        "weighted_sum"
-    }
-
-    fn value_and_grad(
-        &mut self,
-        positions: &[DVec3],
-        triangles: &[[u32; 3]],
-    ) -> Result<(f64, Vec<DVec3>), LossError> {
-        // The terms run concurrently: each is deterministic on its own and their results are
-        // added in term order, so the sum does not depend on the schedule, while one term's
-        // serial stretches (sorting, tree builds, reductions) overlap the other's parallel work.
-        let results: Vec<Result<(f64, Vec<DVec3>), LossError>> = self
-            .terms
-            .par_iter_mut()
-            .map(|(_, loss)| loss.value_and_grad(positions, triangles))
-            .collect();
-        let mut total = 0.0;
-        let mut gradient = vec![DVec3::ZERO; positions.len()];
-        self.last_values.clear();
-        for ((weight, _), result) in self.terms.iter().zip(results) {
-            let (value, grad) = result?;
-            total += *weight * value;
-            self.last_values.push(*weight * value);
-            for (g, d) in gradient.iter_mut().zip(&grad) {
-                *g += *weight * *d;
-            }
-        }
-        Ok((total, gradient))
-    }
-
-    fn set_iteration(&mut self, iteration: usize) {
-        for (_, loss) in &mut self.terms {
-            loss.set_iteration(iteration);
-        }
-    }
-
-    fn last_terms(&self) -> Vec<(&'static str, f64)> {
-        self.terms
-            .iter()
-            .zip(&self.last_values)
-            .map(|((_, loss), &value)| (loss.name(), value))
-            .collect()
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// `L = Σ c·|v|²` with gradient `2c·v`.
-    struct Quadratic(f64);
-
-    impl Loss for Quadratic {
-        fn name(&self) -> &'static str {
-            "quadratic"
-        }
-        fn value_and_grad(
-            &mut self,
-            positions: &[DVec3],
-            _: &[[u32; 3]],
-        ) -> Result<(f64, Vec<DVec3>), LossError> {
-            let value = positions.iter().map(|p| self.0 * p.length_squared()).sum();
-            Ok((value, positions.iter().map(|p| 2.0 * self.0 * *p).collect()))
-        }
-    }
-
-    /// Always fails, naming itself.
-    struct Failing(&'static str);
-
-    impl Loss for Failing {
-        fn name(&self) -> &'static str {
-            self.0
-        }
-        fn value_and_grad(
-            &mut self,
-            _: &[DVec3],
-            _: &[[u32; 3]],
-        ) -> Result<(f64, Vec<DVec3>), LossError> {
-            Err(LossError::InvalidTarget(self.0.to_string()))
-        }
-    }
-
-    #[test]
-    fn weighted_sum_reports_the_first_failing_term_in_term_order() {
-        let mut sum = WeightedSum::default()
-            .with(1.0, Box::new(Quadratic(1.0)))
-            .with(1.0, Box::new(Failing("second")))
-            .with(1.0, Box::new(Failing("third")));
-        let err = sum.value_and_grad(&[DVec3::ONE], &[]).unwrap_err();
-        assert_eq!(err.to_string(), "invalid target: second");
-    }
-
-    #[test]
-    fn weighted_sum_adds_values_and_gradients_with_weights() {
-        let mut sum = WeightedSum::default()
-            .with(3.0, Box::new(Quadratic(1.0)))
-            .with(0.5, Box::new(Quadratic(2.0)));
-        let positions = [DVec3::new(1.0, 2.0, 0.0), DVec3::new(0.0, 0.0, -1.0)];
-        let (value, grad) = sum.value_and_grad(&positions, &[]).unwrap();
-        // Σ|v|² = 6; 3·6 + 0.5·2·6 = 24.
-        assert_eq!(value, 24.0);
-        assert_eq!(sum.last_values, vec![18.0, 6.0]);
-        assert_eq!(
-            sum.last_terms(),
-            vec![("quadratic", 18.0), ("quadratic", 6.0)]
-        );
-        // 3·2v + 0.5·4v = 8v.
-        assert_eq!(grad[0], 8.0 * positions[0]);
-        assert_eq!(grad[1], 8.0 * positions[1]);
-    }
-}
+pub use weighted_sum::WeightedSum;

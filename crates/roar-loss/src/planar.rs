@@ -21,9 +21,10 @@ use roar_mesh::spatial::regular_sampling::{
 pub use roar_mesh::spatial::vertex_normals;
 use roar_mesh::spatial::{RegularSamples, RegularSamplingOptions};
 
+use crate::error::LossError;
 use crate::knn_projector::{KnnOptions, KnnPlanarProjector, answers_in_order};
+use crate::loss::Loss;
 use crate::point_tree::{PointTree, SearchStack};
-use crate::{Loss, LossError};
 
 /// Target points per parallel work item of the t2s assignment.
 const CHUNK: usize = 4096;

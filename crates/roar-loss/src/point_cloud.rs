@@ -20,7 +20,7 @@
 use glam::DVec3;
 use roar_mesh::spatial::{WindingNumber, sample_surface};
 
-use crate::LossError;
+use crate::error::LossError;
 use crate::target::Target;
 
 /// Oriented points: `points[i]` with unit normal `normals[i]`.

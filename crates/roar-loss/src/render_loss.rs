@@ -10,8 +10,9 @@
 use glam::DVec3;
 use roar_render::{Camera, Image, LossKind, RenderOptions, render_loss_and_grad};
 
+use crate::error::LossError;
+use crate::loss::Loss;
 use crate::target::Target;
-use crate::{Loss, LossError};
 
 /// The render loss against fixed target images, one per camera.
 #[derive(Clone, Debug)]

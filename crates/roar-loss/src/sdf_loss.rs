@@ -12,7 +12,8 @@ use std::sync::Arc;
 use glam::DVec3;
 use roar_mesh::spatial::{Sdf, evaluate_with_gradients, first_order_step};
 
-use crate::{Loss, LossError};
+use crate::error::LossError;
+use crate::loss::Loss;
 
 /// Options of [`SdfLoss`].
 #[derive(Clone, Debug, PartialEq)]

@@ -14,7 +14,7 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use roar_mesh::spatial::TriangleBvh;
 
-use crate::LossError;
+use crate::error::LossError;
 use crate::point_cloud::PointCloud;
 
 /// Options of [`sharp_edge_samples`].

@@ -21,7 +21,7 @@ use glam::DVec3;
 use roar_mesh::spatial::{Normalization, TriangleBvh};
 use roar_render::{Camera, Image, RenderOptions, face_pixel_counts, render, star_cameras};
 
-use crate::LossError;
+use crate::error::LossError;
 
 /// Views rendered together: bounds the memory of a forward pass (each view of 512² keeps ids,
 /// depth and colour, ~6 MB) while keeping both cores busy.

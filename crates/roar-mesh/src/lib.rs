@@ -36,6 +36,7 @@ pub mod shapes;
 pub mod spatial;
 mod topology;
 mod tracked;
+mod triangle;
 mod validate;
 
 pub use circulators::{FacesAround, Neighbors, Outgoing};
@@ -43,6 +44,7 @@ pub use compact::Remap;
 pub use error::{BuildError, Element, MeshError, TopoError, ValidationError};
 pub use glam::DVec3;
 pub use handles::{EdgeId, FaceId, HalfedgeId, VertexId};
-pub use mesh::{DEGENERATE_CROSS, DEGENERATE_NORMAL, Mesh};
+pub use mesh::Mesh;
 pub use ops::{Collapse, EdgeSplit, FaceSplitOutcome};
 pub use tracked::{NoStore, TrackedMesh, VertexStore};
+pub use triangle::{DEGENERATE_CROSS, DEGENERATE_NORMAL};

@@ -1,17 +1,11 @@
 //! The [`Mesh`] type: storage, navigation, live-element iteration and per-element geometry.
 
 use crate::handles::{EdgeId, FaceId, HalfedgeId, VertexId};
+use crate::triangle::DEGENERATE_CROSS;
 use glam::DVec3;
 
 /// Raw-array sentinel for "no element"; never exposed by the public API.
 pub(crate) const INVALID: u32 = u32::MAX;
-
-/// Faces with `|cross| <= DEGENERATE_CROSS` get the default normal and clamped area, so no normal
-/// or area is NaN (as in the authors' code; `docs/method.md#conventions`).
-pub const DEGENERATE_CROSS: f64 = 1e-9;
-
-/// Normal of a degenerate face.
-pub const DEGENERATE_NORMAL: DVec3 = DVec3::X;
 
 /// A closed, oriented, 2-manifold triangle mesh in half-edge form.
 ///
@@ -264,7 +258,7 @@ impl Mesh {
     /// Unit normal of `f`; faces with `|cross| <= 1e-9` get `(1, 0, 0)`.
     pub fn face_normal(&self, f: FaceId) -> DVec3 {
         let [a, b, c] = self.face_vertices(f).map(|v| self.position(v));
-        crate::spatial::triangle_normal(a, b, c)
+        crate::triangle::triangle_normal(a, b, c)
     }
 
     /// Area of `f`, clamped below at `1e-9` so that no ratio of areas is NaN.

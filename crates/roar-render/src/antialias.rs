@@ -18,8 +18,8 @@
 //! The blend is continuous in `t` (zero at `t = ½`), and `t` is a closed-form function of the
 //! edge endpoints' pixel coordinates, so coverage gets position gradients through it.
 
-use crate::BACKGROUND;
 use crate::camera::ProjectedVertex;
+use crate::raster::BACKGROUND;
 use crate::topology::{EdgeNeighbors, NO_NEIGHBOR};
 
 /// Most triangles a pair's segment is followed through to find the silhouette edge.

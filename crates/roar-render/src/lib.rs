@@ -25,87 +25,20 @@
 
 pub mod antialias;
 pub mod camera;
+mod draw;
+mod error;
 pub mod loss;
 pub mod normals;
-mod pipeline;
+mod options;
 pub mod raster;
+mod renders;
 pub mod topology;
 
 pub use antialias::AaItem;
 pub use camera::{Camera, star_cameras};
+pub use draw::{backward, render, render_loss_and_grad};
+pub use error::RenderError;
 pub use loss::{LossKind, image_loss};
-pub use pipeline::{
-    Image, Renders, ViewRender, backward, face_pixel_counts, render, render_loss_and_grad, to_rgba8,
-};
-
-/// Triangle id stored in pixels that no triangle covers.
-pub const BACKGROUND: u32 = u32::MAX;
-
-/// Options of the rasterizer.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct RenderOptions {
-    /// Skip triangles that face away from the camera. Off by default: the render loss
-    /// (like Continuous Remeshing) renders both sides, so a fold shows its reversed normal; the
-    /// soup orientation clean-up, which counts each twin's visible pixels, turns it on.
-    pub cull_backfaces: bool,
-    /// Analytic antialiasing; the only source of silhouette and
-    /// occlusion gradients. On by default.
-    pub antialias: bool,
-}
-
-impl Default for RenderOptions {
-    fn default() -> Self {
-        Self {
-            cull_backfaces: false,
-            antialias: true,
-        }
-    }
-}
-
-/// Everything that can go wrong when rendering user input.
-#[derive(Debug, thiserror::Error, Clone, PartialEq)]
-pub enum RenderError {
-    /// A vertex lies on or behind the near plane of a camera (the rig expects meshes normalized
-    /// into the sphere of radius 0.95; no clipping is done).
-    #[error("vertex {vertex} lies behind the near plane of camera {camera}")]
-    BehindNearPlane {
-        /// Index of the offending vertex.
-        vertex: usize,
-        /// Index of the camera.
-        camera: usize,
-    },
-    /// A vertex coordinate is NaN or infinite.
-    #[error("vertex {vertex} has a non-finite coordinate")]
-    NonFiniteVertex {
-        /// Index of the offending vertex.
-        vertex: usize,
-    },
-    /// A triangle references a vertex that does not exist.
-    #[error(
-        "triangle {face} references vertex {vertex}, but there are only {num_vertices} vertices"
-    )]
-    IndexOutOfRange {
-        /// Index of the triangle.
-        face: usize,
-        /// The bad vertex index.
-        vertex: u32,
-        /// Number of vertices given.
-        num_vertices: usize,
-    },
-    /// A camera has a zero width or height.
-    #[error("camera {camera} has an empty resolution {width}x{height}")]
-    EmptyResolution {
-        /// Index of the camera.
-        camera: usize,
-        /// Width in pixels.
-        width: u32,
-        /// Height in pixels.
-        height: u32,
-    },
-    /// Buffers passed together do not match in count or size.
-    #[error("shape mismatch: {what}")]
-    ShapeMismatch {
-        /// Which buffers disagree, and how.
-        what: String,
-    },
-}
+pub use options::RenderOptions;
+pub use raster::BACKGROUND;
+pub use renders::{Image, Renders, ViewRender, face_pixel_counts, to_rgba8};

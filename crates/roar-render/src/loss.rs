@@ -1,7 +1,8 @@
 //! Image losses of the render loss: the mean over views × pixels × 4 channels of `|I − T|` (L1, the
 //! paper's) or `(I − T)²` (L2), and their gradients with respect to the rendered image.
 
-use crate::{Image, RenderError, Renders};
+use crate::error::RenderError;
+use crate::renders::{Image, Renders};
 
 /// Gradient of a loss with respect to the rendered images: per view, per pixel, RGBA.
 pub type ImageGrad = Vec<Vec<[f64; 4]>>;

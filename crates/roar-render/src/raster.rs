@@ -8,8 +8,10 @@
 //! affine in screen space, evaluated in `f32`; ties break on the triangle's vertex indices, so the
 //! result does not depend on the order of the triangle list.
 
-use crate::BACKGROUND;
 use crate::camera::ProjectedVertex;
+
+/// Triangle id stored in pixels that no triangle covers.
+pub const BACKGROUND: u32 = u32::MAX;
 
 /// Sub-pixel resolution of the fixed-point vertex snap (bits).
 const SUBPIXEL_BITS: u32 = 8;

@@ -25,7 +25,7 @@ use rayon::prelude::*;
 use roar_mesh::spatial::{Sdf, SdfCounter, SdfEvaluations};
 use serde::Deserialize;
 
-use crate::SdfError;
+use crate::error::SdfError;
 
 /// One node as written in the file (every field optional; [`Node::from_spec`] checks them).
 #[derive(Debug, Deserialize)]

@@ -20,7 +20,7 @@ use rayon::prelude::*;
 use roar_mesh::spatial::{Aabb, Sdf, SdfCounter, SdfEvaluations};
 use serde::Deserialize;
 
-use crate::SdfError;
+use crate::error::SdfError;
 
 /// Points interpolated per parallel task.
 const CHUNK: usize = 4096;

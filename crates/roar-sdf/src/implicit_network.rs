@@ -28,7 +28,7 @@ use roar_mesh::spatial::Aabb;
 use safetensors::{Dtype, SafeTensors};
 use serde::Deserialize;
 
-use crate::SdfError;
+use crate::error::SdfError;
 use crate::grid::BoundsSpec;
 use crate::network::{Activation, Mlp, Op};
 

@@ -10,6 +10,7 @@
 //! ([`extract`]).
 
 pub mod analytic;
+mod error;
 pub mod extract;
 pub mod grid;
 pub mod implicit_network;
@@ -24,31 +25,12 @@ use glam::DVec3;
 use roar_mesh::spatial::{Aabb, Normalization, Sdf, SdfEvaluations};
 
 pub use analytic::AnalyticSdf;
+pub use error::SdfError;
 pub use extract::{ExtractOptions, ExtractStats, extract_zero_set};
 pub use grid::GridSdf;
 pub use network::{Activation, Mlp};
 pub use project::{SdfProjector, SdfProjectorOptions, project_samples};
 pub use trace::{TraceOptions, TraceStats, trace_normal_maps};
-
-/// Why an SDF file could not be read. Every message is one line.
-#[derive(Debug, thiserror::Error)]
-pub enum SdfError {
-    /// The file could not be read.
-    #[error("{0}")]
-    Io(String),
-    /// A malformed network file (names the tensor).
-    #[error("{0}")]
-    Network(String),
-    /// A malformed `.sdf.toml` file (names the node).
-    #[error("{0}")]
-    Analytic(String),
-    /// A malformed `.npy` grid or its sidecar.
-    #[error("{0}")]
-    Grid(String),
-    /// The file's extension names no SDF kind.
-    #[error("not an SDF input (.npz, .safetensors, .sdf.toml or .npy)")]
-    UnknownKind,
-}
 
 /// The bounds an SDF input is reconstructed in, and a grid without a sidecar is placed over,
 /// when none are given: `[-1.1, 1.1]³`.

@@ -20,7 +20,7 @@ use ndarray_npy::NpzReader;
 use rayon::prelude::*;
 use roar_mesh::spatial::{Sdf, SdfCounter, SdfEvaluations};
 
-use crate::SdfError;
+use crate::error::SdfError;
 
 /// Points evaluated together in one matrix product (rows of a batch); batches run in parallel.
 const CHUNK: usize = 2048;

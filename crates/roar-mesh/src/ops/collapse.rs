@@ -1,6 +1,6 @@
 //! Half-edge collapse.
 
-use super::Wings;
+use super::wings::Wings;
 use crate::error::TopoError;
 use crate::handles::{EdgeId, FaceId, HalfedgeId, VertexId};
 use crate::mesh::Mesh;

@@ -1,6 +1,6 @@
 //! Edge flip.
 
-use super::Wings;
+use super::wings::Wings;
 use crate::error::TopoError;
 use crate::handles::EdgeId;
 use crate::mesh::Mesh;

@@ -32,7 +32,11 @@ pub mod sampling;
 pub mod sdf;
 pub mod self_intersections;
 pub mod tri_tri;
-pub mod triangle;
+pub mod triangle {
+    //! One triangle's shape (normal, angles, aspect ratio, the degenerate-face constants). The
+    //! code lives in the crate's private `triangle` module, below both the mesh and these kernels.
+    pub use crate::triangle::*;
+}
 pub mod vertex_normals;
 pub mod winding;
 

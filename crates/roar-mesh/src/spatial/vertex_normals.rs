@@ -2,8 +2,7 @@
 //! function. Faces with an out-of-range index are skipped; a vertex whose sum vanishes (or that
 //! no face references) gets a zero normal.
 
-use super::triangle::{corner_angles, triangle_normal};
-use crate::DEGENERATE_CROSS;
+use super::triangle::{DEGENERATE_CROSS, corner_angles, triangle_normal};
 use glam::DVec3;
 
 /// The ROAR weighting (`docs/method.md#conventions`) of face `p`: its unit normal and, at each

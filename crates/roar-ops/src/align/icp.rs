@@ -12,7 +12,8 @@ use glam::{DQuat, DVec3};
 use nalgebra::{Matrix6, Vector6};
 use roar_mesh::spatial::{TriangleBvh, vertex_normals};
 
-use super::{RigidTransform, ScanPatch};
+use super::patch::ScanPatch;
+use super::transform::RigidTransform;
 
 /// How [`icp`] runs.
 #[derive(Debug, Clone, Copy, PartialEq)]

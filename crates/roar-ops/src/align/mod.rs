@@ -8,53 +8,14 @@
 //! reported as such rather than pulled onto whatever is nearest.
 
 mod icp;
+mod patch;
+mod transform;
 
 pub use icp::{IcpOptions, IcpResult, icp};
+pub use patch::ScanPatch;
+pub use transform::RigidTransform;
 
-use glam::{DQuat, DVec3};
 use roar_mesh::spatial::TriangleBvh;
-
-/// A rigid transform `x ↦ R x + t`.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct RigidTransform {
-    /// The rotation R (unit quaternion).
-    pub rotation: DQuat,
-    /// The translation t.
-    pub translation: DVec3,
-}
-
-impl RigidTransform {
-    /// The identity.
-    pub const IDENTITY: RigidTransform = RigidTransform {
-        rotation: DQuat::IDENTITY,
-        translation: DVec3::ZERO,
-    };
-
-    /// `R p + t`.
-    pub fn apply(&self, p: DVec3) -> DVec3 {
-        self.rotation * p + self.translation
-    }
-
-    /// The angle of `other · self⁻¹` in degrees and the distance between the two translations
-    /// measured at `at` (where the transforms place the point `at` of the scan's frame).
-    pub fn difference(&self, other: &RigidTransform, at: DVec3) -> (f64, f64) {
-        let relative = other.rotation * self.rotation.inverse();
-        let angle = relative
-            .normalize()
-            .angle_between(DQuat::IDENTITY)
-            .to_degrees();
-        (angle, self.apply(at).distance(other.apply(at)))
-    }
-}
-
-/// One scan's patch in its own frame.
-#[derive(Debug, Clone, Copy)]
-pub struct ScanPatch<'a> {
-    /// Vertices in the scan's frame.
-    pub positions: &'a [DVec3],
-    /// Triangles (indices into `positions`), oriented toward the scanner.
-    pub triangles: &'a [[u32; 3]],
-}
 
 /// How [`align_scans`] runs.
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -40,42 +40,18 @@
 //! at the cut) is done in the global cheapest-first order. The answer does not depend on the
 //! thread count.
 
-use super::{
-    DecimateError, DecimateOptions, DecimateStats, Decimator, VetoCounts, check_request, decimate,
-};
+use super::budget::check_request;
+use super::decimator::{Decimator, decimate};
+use super::error::DecimateError;
+use super::options::DecimateOptions;
+use super::slab::Slab;
+use super::stats::{DecimateStats, VetoCounts};
 use glam::DVec3;
-use roar_mesh::{HalfedgeId, Mesh};
+use roar_mesh::Mesh;
 
 /// Meshes with fewer faces are decimated sequentially ([`decimate`]); below it the copies and
 /// the merge cost more than the second thread saves.
 const MIN_FACES_TO_SPLIT: usize = 50_000;
-
-/// An open slab `lo < p[axis] < hi`.
-#[derive(Debug, Clone, Copy)]
-pub(super) struct Slab {
-    axis: usize,
-    lo: f64,
-    hi: f64,
-}
-
-impl Slab {
-    /// Whether `p` lies strictly inside.
-    pub(super) fn contains(&self, p: DVec3) -> bool {
-        self.lo < p[self.axis] && p[self.axis] < self.hi
-    }
-
-    /// Whether collapsing `h` with placement `p` keeps every changed face inside: `p` and every
-    /// vertex around both endpoints are inside.
-    pub(super) fn holds_collapse(&self, mesh: &Mesh, h: HalfedgeId, p: DVec3) -> bool {
-        self.contains(p)
-            && [mesh.tail(h), mesh.head(h)].into_iter().all(|v| {
-                self.contains(mesh.position(v))
-                    && mesh
-                        .outgoing(v)
-                        .all(|o| self.contains(mesh.position(mesh.head(o))))
-            })
-    }
-}
 
 /// Decimates `mesh` to exactly `target_faces` faces with the promises of [`decimate`], using two
 /// threads for large meshes (see the module doc); small meshes and small reductions go straight

@@ -1,7 +1,10 @@
 //! The pipeline's initial mesh: the watertight init, then QEM to at most 20k faces, as the authors
 //! simplify Manifold's output (`docs/method.md#watertight-init`).
 
-use super::{InitError, InitOptions, InitStats, WatertightInit, watertight_init};
+use super::error::InitError;
+use super::options::InitOptions;
+use super::output::{InitStats, WatertightInit};
+use super::watertight::watertight_init;
 use crate::decimate::{DecimateOptions, DecimateStats, decimate_in_parallel, minimum_faces};
 use glam::DVec3;
 use roar_mesh::Mesh;

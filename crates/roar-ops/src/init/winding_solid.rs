@@ -83,7 +83,7 @@ pub(crate) fn fill_enclosed(
     // triangle sits in a wide leaf of the fast winding number's tree, which every query near it
     // must evaluate exactly, while short ones are summed by the far-field expansion.
     let (positions, triangles) =
-        super::split_long_edges(&first_of_each_twin_pair(soup), 4.0 * grid.voxel_size);
+        super::soup::split_long_edges(&first_of_each_twin_pair(soup), 4.0 * grid.voxel_size);
     let Ok(winding) = WindingNumber::build(&positions, &triangles) else {
         // Unreachable: the indices above are in range by construction.
         return EnclosedFill::default();
@@ -443,7 +443,7 @@ mod tests {
         // voxel's verdict equals its own winding number's, with far fewer evaluations.
         let mut soup = box_soup(DVec3::ZERO, DVec3::ONE, true);
         soup.extend(box_soup(DVec3::splat(2.0), DVec3::splat(3.0), false).split_off(2));
-        let (positions, triangles) = super::super::split_long_edges(&soup, 0.1);
+        let (positions, triangles) = super::super::soup::split_long_edges(&soup, 0.1);
         let winding = WindingNumber::build(&positions, &triangles).unwrap();
         let grid = Grid::around(DVec3::ZERO, DVec3::splat(3.0), 60, 3);
         let state = flooded(&grid, &soup);
@@ -482,7 +482,7 @@ mod tests {
     #[test]
     fn splitting_long_edges_keeps_the_winding_number() {
         let soup = box_soup(DVec3::ZERO, DVec3::new(4.0, 1.0, 0.5), true);
-        let (p1, t1) = super::super::split_long_edges(&soup, 0.3);
+        let (p1, t1) = super::super::soup::split_long_edges(&soup, 0.3);
         assert!(t1.len() > 10 * soup.len());
         let p0: Vec<DVec3> = soup.iter().flatten().copied().collect();
         let t0: Vec<[u32; 3]> = (0..soup.len() as u32)

@@ -6,7 +6,7 @@
 //! each ring, whose length is the valence) and reuses its buffers, so it allocates nothing once
 //! the buffers have reached the mesh's size.
 
-use super::OptimError;
+use super::error::OptimError;
 
 /// Unique 1-ring neighbours of every vertex, stored as compressed sparse rows: the neighbours
 /// of `v` are `neighbors[offsets[v]..offsets[v + 1]]`, sorted ascending, without duplicates

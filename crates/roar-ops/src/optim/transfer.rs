@@ -23,7 +23,9 @@
 
 use roar_mesh::{Collapse, EdgeSplit, FaceSplitOutcome, Remap, VertexStore};
 
-use super::{OptimError, Optimizer, VertexState};
+use super::error::OptimError;
+use super::optimizer::Optimizer;
+use super::state::VertexState;
 
 /// The store calls of a [`roar_mesh::TrackedMesh`] name only vertex slots it grew the rows
 /// to, so a failing transfer is a bug in the mesh's bookkeeping.

@@ -2,7 +2,7 @@
 //! of a crossing must go; bad vertices grow the moving region; pairs without a bad vertex are
 //! smoothed.
 
-use super::UntangleOptions;
+use super::options::UntangleOptions;
 use glam::DVec3;
 use roar_mesh::spatial::{WindingNumber, area_weighted_vertex_normals};
 use std::collections::{BTreeSet, VecDeque};

@@ -1,8 +1,14 @@
 //! One triangle's shape: its unit normal, its corner angles and its aspect ratio, each with one
 //! rule for degenerate triangles that every crate shares.
 
-use crate::{DEGENERATE_CROSS, DEGENERATE_NORMAL};
 use glam::DVec3;
+
+/// Faces with `|cross| <= DEGENERATE_CROSS` get the default normal and clamped area, so no normal
+/// or area is NaN (as in the authors' code; `docs/method.md#conventions`).
+pub const DEGENERATE_CROSS: f64 = 1e-9;
+
+/// Normal of a degenerate face.
+pub const DEGENERATE_NORMAL: DVec3 = DVec3::X;
 
 /// Unit normal of triangle `(a, b, c)`; a triangle with `|cross| ≤ 1e-9` (or non-finite corners)
 /// gets `(1, 0, 0)` (`docs/method.md#conventions`).
