@@ -2,7 +2,118 @@
 //! default, each documented with the section of `spec/roar-method.md` it comes from. A TOML
 //! file overrides any subset (unknown keys are errors); the CLI's flags override the file.
 
+use roar_io::PatchOptions;
+use roar_loss::planar::{DEFAULT_MAX_SAMPLES, DEFAULT_T2S_MAX_POINTS, RECONSTRUCTION_PLANAR_SCALE};
+use roar_loss::{
+    KnnOptions, PlanarOptions, PointCloudOptions, SdfLossOptions, SharpEdgeOptions, TargetOptions,
+};
+use roar_ops::blocks::collapse::FaceCollapseOptions;
+use roar_ops::blocks::split::DEFAULT_SPLIT_THRESHOLD;
+use roar_ops::finish::data_flips::DataFlipOptions;
+use roar_ops::finish::fins::FinOptions;
+use roar_ops::finish::slivers::SliverOptions;
+use roar_ops::finish::zero_set::ZeroSetOptions;
+use roar_ops::init::{
+    ENCLOSURE_MAX_CAP_FRACTION, ENCLOSURE_WINDING_THRESHOLD, InitialMeshOptions, SdfInitOptions,
+};
+use roar_ops::optim::OptimizerOptions;
+use roar_ops::untangle::UntangleOptions;
+use roar_sdf::{SdfProjectorOptions, TraceOptions};
 use serde::{Deserialize, Serialize};
+
+/// Declares one table of the configuration, each field once: its doc, name, type, default and,
+/// for a numeric field, its allowed range (`range(min, max)`: `min ..= max`; `zero_or(min, max)`:
+/// 0 as well, meaning "off"; booleans and enums have none). Derives the struct (every key
+/// optional, unknown keys refused, the fields in the order written, which is the TOML's), its
+/// `Default` and its `field_ranges`, the ranges named `table.field` as the messages name them.
+macro_rules! config_table {
+    (
+        $(#[$meta:meta])*
+        pub struct $name:ident($table:literal) {
+            $(
+                $(#[$field_meta:meta])*
+                $field:ident: $ty:ty = $default:expr $(, $kind:ident($min:expr, $max:expr))?;
+            )*
+        }
+    ) => {
+        $(#[$meta])*
+        #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+        #[serde(default, deny_unknown_fields)]
+        pub struct $name {
+            $(
+                $(#[$field_meta])*
+                #[doc = ""]
+                #[doc = concat!(
+                    "Default: `", stringify!($default), "`",
+                    $("; allowed: `", stringify!($kind($min, $max)), "`",)?
+                    "."
+                )]
+                pub $field: $ty,
+            )*
+        }
+
+        impl Default for $name {
+            fn default() -> Self {
+                Self {
+                    $($field: $default,)*
+                }
+            }
+        }
+
+        impl $name {
+            /// Every numeric field of the table with its allowed range and its current value,
+            /// in declaration order.
+            pub fn field_ranges(&self) -> Vec<(FieldRange, f64)> {
+                vec![
+                    $($(
+                        (
+                            field_range!(
+                                $kind,
+                                concat!($table, ".", stringify!($field)),
+                                $min,
+                                $max
+                            ),
+                            RangeValue::range_value(self.$field),
+                        ),
+                    )?)*
+                ]
+            }
+        }
+    };
+}
+
+/// The [`FieldRange`] of a `range(min, max)` or `zero_or(min, max)` declaration.
+macro_rules! field_range {
+    (range, $name:expr, $min:expr, $max:expr) => {
+        FieldRange::new($name, $min, $max)
+    };
+    (zero_or, $name:expr, $min:expr, $max:expr) => {
+        FieldRange::zero_or($name, $min, $max)
+    };
+}
+
+/// A numeric field's value as its range compares it.
+trait RangeValue {
+    fn range_value(self) -> f64;
+}
+
+impl RangeValue for f64 {
+    fn range_value(self) -> f64 {
+        self
+    }
+}
+
+impl RangeValue for u32 {
+    fn range_value(self) -> f64 {
+        f64::from(self)
+    }
+}
+
+impl RangeValue for usize {
+    fn range_value(self) -> f64 {
+        self as f64
+    }
+}
 
 /// The enclosure rule's threshold for scan sets (`enclosure_winding_threshold` of
 /// `ReconstructConfig::scan_defaults`), below the
@@ -61,386 +172,289 @@ impl Default for ReconstructConfig {
     }
 }
 
-/// `[target]`
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(default, deny_unknown_fields)]
-pub struct TargetConfig {
-    /// Views per axis of the star rig: n² views (§3.2.1: 6 → 36). Default 5 (25 views); 6 in
-    /// the SDF and scan schedules. [INF] Fewer views than the paper: each loop iteration
-    /// renders 31 % fewer pixels and the loop levels off sooner, for a Chamfer distance within
-    /// 0.2 % (median) of 36 views on the wild meshes (`docs/method.md`, "The rig has 25 views").
-    pub views_per_axis: usize,
-    /// Render resolution in pixels (§3.2.1: 512).
-    pub render_resolution: u32,
-    /// Keep both twins of a soup face unless one has this many times more pixels (§3.1 a: 80).
-    pub twin_ratio: f64,
-    /// Target point cloud samples (§3.1 b: 200k).
-    pub point_cloud_samples: usize,
-    /// Keep target samples whose winding number at p + 1e-3·n is below this (§3.1 b, OQ-14).
-    pub winding_threshold: f64,
-    /// Target samples on a sheet (a face of T′ whose reversed twin is kept too: an open surface
-    /// or a zero-thickness part) stand off it by this much along their normal, relative to the
-    /// bounding-box diagonal, so the two sides of the closed output each get their own plane
-    /// instead of jamming against each other on one (0 = off). [INF] Not in the paper; the
-    /// value is the offset CGAL's alpha wrap is run with in the evaluation (`roar_loss::
-    /// point_cloud` explains the jam; at 5000 faces the normal cosine rose on every sheet of the
-    /// evaluation, the Chamfer distance grew on closely fitted ones: `docs/method.md`, "Sheets get
-    /// one plane per side").
-    pub sheet_offset: f64,
-    /// Sharp-edge samples from the init (§3.1 c: 30k).
-    pub sharp_edge_samples: usize,
-    /// Range scans: a patch triangle with an edge longer than this many times the local grid
-    /// spacing bridges a depth jump and is dropped (`roar_io::PatchOptions::max_edge_factor`,
-    /// where the default is measured).
-    pub scan_max_edge_factor: f64,
-    /// Range scans: a patch triangle whose normal is more than this many degrees from the
-    /// direction to the scanner is dropped (`roar_io::PatchOptions::max_angle_degrees`).
-    pub scan_max_angle_degrees: f64,
-    /// Range scans: refine the `.conf` poses by ICP (`roar_ops::align`); `--no-icp` turns it off.
-    pub scan_icp: bool,
-    /// Cells of the grid that brackets the zero set for an SDF input's traced target renders
-    /// (`roar_sdf::trace`): features thinner than about one cell can be missed.
-    pub sdf_trace_grid: usize,
-    /// Regula falsi steps per traced pixel of an SDF input.
-    pub sdf_trace_refine_steps: usize,
-    /// First-order steps of an SDF input's projections: the Face Split projector (§3.4 C: 5)
-    /// and the point-cloud samples.
-    pub sdf_projection_steps: usize,
-    /// A projected sample of an SDF input is valid when its first-order distance `|f|/|∇f|` ends
-    /// at most this, in rig units (§3.4 C: 1e-6 for float64 fields; f32 networks need more).
-    pub sdf_projection_tolerance: f64,
-}
-
-impl Default for TargetConfig {
-    fn default() -> Self {
-        Self {
-            views_per_axis: 5,
-            render_resolution: 512,
-            twin_ratio: 80.0,
-            point_cloud_samples: 200_000,
-            winding_threshold: 0.2,
-            sheet_offset: 1e-3,
-            sharp_edge_samples: 30_000,
-            scan_max_edge_factor: 4.0,
-            scan_max_angle_degrees: 80.0,
-            scan_icp: true,
-            sdf_trace_grid: 128,
-            sdf_trace_refine_steps: 8,
-            sdf_projection_steps: 5,
-            sdf_projection_tolerance: 1e-5,
-        }
+config_table! {
+    /// `[target]`
+    pub struct TargetConfig("target") {
+        /// Views per axis of the star rig: n² views (§3.2.1: 6 → 36). Default 5 (25 views); 6 in
+        /// the SDF and scan schedules. [INF] Fewer views than the paper: each loop iteration
+        /// renders 31 % fewer pixels and the loop levels off sooner, for a Chamfer distance within
+        /// 0.2 % (median) of 36 views on the wild meshes (`docs/method.md`, "The rig has 25 views").
+        views_per_axis: usize = 5, range(1.0, 32.0);
+        /// Render resolution in pixels (§3.2.1: 512).
+        render_resolution: u32 = TargetOptions::default().resolution, range(16.0, 4096.0);
+        /// Keep both twins of a soup face unless one has this many times more pixels (§3.1 a: 80).
+        twin_ratio: f64 = TargetOptions::default().twin_ratio, range(1.0, 1e6);
+        /// Target point cloud samples (§3.1 b: 200k).
+        point_cloud_samples: usize = PointCloudOptions::default().samples, range(100.0, 5e7);
+        /// Keep target samples whose winding number at p + 1e-3·n is below this (§3.1 b, OQ-14).
+        winding_threshold: f64 = PointCloudOptions::default().winding_threshold, range(1e-6, 1.0);
+        /// Target samples on a sheet (a face of T′ whose reversed twin is kept too: an open surface
+        /// or a zero-thickness part) stand off it by this much along their normal, relative to the
+        /// bounding-box diagonal, so the two sides of the closed output each get their own plane
+        /// instead of jamming against each other on one (0 = off). [INF] Not in the paper; the
+        /// value is the offset CGAL's alpha wrap is run with in the evaluation (`roar_loss::
+        /// point_cloud` explains the jam; at 5000 faces the normal cosine rose on every sheet of the
+        /// evaluation, the Chamfer distance grew on closely fitted ones: `docs/method.md`, "Sheets get
+        /// one plane per side").
+        sheet_offset: f64 = 1e-3, range(0.0, 0.1);
+        /// Sharp-edge samples from the init (§3.1 c: 30k).
+        sharp_edge_samples: usize = SharpEdgeOptions::default().samples, range(0.0, 5e7);
+        /// Range scans: a patch triangle with an edge longer than this many times the local grid
+        /// spacing bridges a depth jump and is dropped (`roar_io::PatchOptions::max_edge_factor`,
+        /// where the default is measured).
+        scan_max_edge_factor: f64 = PatchOptions::default().max_edge_factor, range(1.0, 1e3);
+        /// Range scans: a patch triangle whose normal is more than this many degrees from the
+        /// direction to the scanner is dropped (`roar_io::PatchOptions::max_angle_degrees`).
+        scan_max_angle_degrees: f64 = PatchOptions::default().max_angle_degrees, range(1.0, 90.0);
+        /// Range scans: refine the `.conf` poses by ICP (`roar_ops::align`); `--no-icp` turns it off.
+        scan_icp: bool = true;
+        /// Cells of the grid that brackets the zero set for an SDF input's traced target renders
+        /// (`roar_sdf::trace`): features thinner than about one cell can be missed.
+        sdf_trace_grid: usize = TraceOptions::default().grid_resolution, range(2.0, 2048.0);
+        /// Regula falsi steps per traced pixel of an SDF input.
+        sdf_trace_refine_steps: usize = TraceOptions::default().refine_steps, range(0.0, 100.0);
+        /// First-order steps of an SDF input's projections: the Face Split projector (§3.4 C: 5)
+        /// and the point-cloud samples.
+        sdf_projection_steps: usize = SdfProjectorOptions::default().steps, range(1.0, 100.0);
+        /// A projected sample of an SDF input is valid when its first-order distance `|f|/|∇f|` ends
+        /// at most this, in rig units (§3.4 C: 1e-6 for float64 fields; f32 networks need more).
+        sdf_projection_tolerance: f64 = SdfProjectorOptions::default().tolerance, range(1e-12, 1.0);
     }
 }
 
-/// `[init]`
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(default, deny_unknown_fields)]
-pub struct InitConfig {
-    /// Initial mesh (§4).
-    pub kind: InitKind,
-    /// Voxels along the longest axis of the watertight init (replaces Manifold's octree
-    /// resolution, OQ-12). The init closes gaps of one voxel and the loop never changes the
-    /// genus, so this decides which slots and holes of the input survive: 192 keeps gaps down to
-    /// about diag/170 on a box-like shape, on a par with alpha wrapping at α = diag/300, where
-    /// `roar init`'s 128 fills the slots between a chair's slats. 256 opens narrower cavities
-    /// (libigl-camelhead's ears) and costs 3–5 s more on the wild meshes, but gains less than it
-    /// gives roar's own init + QEM (`docs/method.md`).
-    pub init_resolution: usize,
-    /// The init is decimated to at most this many faces (§4.1: 20k).
-    pub init_max_faces: usize,
-    /// Enclosure rule of the watertight init (`roar_ops::init::winding_solid`; 0 = off):
-    /// exterior voxels whose generalized winding number with respect to T′ is above this value
-    /// turn solid, so punctures of a closed surface close while tunnels stay. Default
-    /// `roar_ops::init::ENCLOSURE_WINDING_THRESHOLD` (0.7).
-    pub enclosure_winding_threshold: f64,
-    /// A region the enclosure rule fills stays filled only if its widest cap (a patch of its
-    /// boundary no input surface covers) is at most this fraction of its boundary: punctures
-    /// close, the wide opening of an open surface stays open. Default
-    /// `roar_ops::init::ENCLOSURE_MAX_CAP_FRACTION` (0.02); 1 closes every opening.
-    pub enclosure_max_cap_fraction: f64,
-    /// Subdivision level of the sphere init. Default 4 (§4.2 has 2; more helps a sphere reach
-    /// detail).
-    pub sphere_level: u32,
-    /// Cells along the longest side of an SDF input's bounds for its voxel init (§4.3: 64).
-    pub sdf_init_resolution: usize,
-}
-
-impl Default for InitConfig {
-    fn default() -> Self {
-        Self {
-            kind: InitKind::Watertight,
-            init_resolution: 192,
-            init_max_faces: 20_000,
-            enclosure_winding_threshold: roar_ops::init::ENCLOSURE_WINDING_THRESHOLD,
-            enclosure_max_cap_fraction: roar_ops::init::ENCLOSURE_MAX_CAP_FRACTION,
-            sphere_level: 4,
-            sdf_init_resolution: 64,
-        }
+config_table! {
+    /// `[init]`
+    pub struct InitConfig("init") {
+        /// Initial mesh (§4).
+        kind: InitKind = InitKind::Watertight;
+        /// Voxels along the longest axis of the watertight init (replaces Manifold's octree
+        /// resolution, OQ-12). The init closes gaps of one voxel and the loop never changes the
+        /// genus, so this decides which slots and holes of the input survive: 192 keeps gaps down to
+        /// about diag/170 on a box-like shape, on a par with alpha wrapping at α = diag/300, where
+        /// `roar init`'s 128 fills the slots between a chair's slats. 256 opens narrower cavities
+        /// (libigl-camelhead's ears) and costs 3–5 s more on the wild meshes, but gains less than it
+        /// gives roar's own init + QEM (`docs/method.md`).
+        init_resolution: usize = 192, range(8.0, 1024.0);
+        /// The init is decimated to at most this many faces (§4.1: 20k).
+        init_max_faces: usize = InitialMeshOptions::default().max_faces, range(4.0, 1e7);
+        /// Enclosure rule of the watertight init (`roar_ops::init::winding_solid`; 0 = off):
+        /// exterior voxels whose generalized winding number with respect to T′ is above this value
+        /// turn solid, so punctures of a closed surface close while tunnels stay. Default
+        /// `roar_ops::init::ENCLOSURE_WINDING_THRESHOLD` (0.7).
+        enclosure_winding_threshold: f64 = ENCLOSURE_WINDING_THRESHOLD, zero_or(0.5, 1.0);
+        /// A region the enclosure rule fills stays filled only if its widest cap (a patch of its
+        /// boundary no input surface covers) is at most this fraction of its boundary: punctures
+        /// close, the wide opening of an open surface stays open. Default
+        /// `roar_ops::init::ENCLOSURE_MAX_CAP_FRACTION` (0.02); 1 closes every opening.
+        enclosure_max_cap_fraction: f64 = ENCLOSURE_MAX_CAP_FRACTION, range(0.0, 1.0);
+        /// Subdivision level of the sphere init. Default 4 (§4.2 has 2; more helps a sphere reach
+        /// detail).
+        sphere_level: u32 = 4, range(0.0, 8.0);
+        /// Cells along the longest side of an SDF input's bounds for its voxel init (§4.3: 64).
+        sdf_init_resolution: usize = SdfInitOptions::default().resolution, range(2.0, 1024.0);
     }
 }
 
-/// `[loss]`
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(default, deny_unknown_fields)]
-pub struct LossConfig {
-    /// λ1, the render loss weight (§3.2.3: 3).
-    pub render_weight: f64,
-    /// λ2, the planar projection loss weight (§3.2.3: 1).
-    pub planar_weight: f64,
-    /// Scale of the planar term before its weight (Verification note 2). Measured with
-    /// `crates/roar-cli/examples/loss_balance.rs` on wild meshes' inits at 5k faces: mean per-vertex gradient of
-    /// 3·render ≈ 3.1e-3, raw planar ≈ 1.3e-6–3.1e-6, Laplacian ≈ 3e-4–6e-4; at 500 the planar
-    /// term (6e-4–1.5e-3) is within 5× of the render term instead of 500× below it.
-    pub planar_scale: f64,
-    /// Source samples kept per planar loss evaluation (§3.2.2 cap; the default and why:
-    /// `roar_loss::planar::DEFAULT_MAX_SAMPLES`; 50,000 in the SDF and scan schedules).
-    pub planar_max_samples: usize,
-    /// Neighbours of the k-NN planar projection (§8: s2t_neighbours 10).
-    pub planar_neighbours: usize,
-    /// Include the target-to-source term (OQ-3).
-    pub planar_t2s: bool,
-    /// Target points the t2s term queries per evaluation, a different spatially even subset
-    /// each time (0: all, the paper's; the default and why:
-    /// `roar_loss::planar::DEFAULT_T2S_MAX_POINTS`; 0 in the SDF and scan schedules).
-    pub planar_t2s_max_points: usize,
-    /// Side in pixels of the coarse views the render loss uses for the loop's first
-    /// `render_coarse_fraction` of iterations (and the polish, see `render_coarse_polish`), when
-    /// below `render_resolution`
-    /// (`roar_loss::CoarseViews`; the paper renders every iteration at `render_resolution`,
-    /// `docs/method.md` says why not). Default 256.
-    pub render_coarse_resolution: u32,
-    /// Fraction of the loop's iterations rendered at `render_coarse_resolution`, from the
-    /// first (0: none, the paper's schedule). Default 1: the whole loop; 0 in the SDF and scan
-    /// schedules.
-    pub render_coarse_fraction: f64,
-    /// When the whole loop renders at `render_coarse_resolution`, the finish's polish does too
-    /// (false: the polish renders at `render_resolution`). Default true (`docs/method.md` has
-    /// the cost and the fidelity of both).
-    pub render_coarse_polish: bool,
-    /// Weight of the SDF projection loss (§5: 0.1), in the objective only for inputs with a
-    /// signed distance (`roar_loss::SdfLoss`).
-    pub sdf_loss_weight: f64,
-    /// Loop iteration from which the SDF loss is on (§5: 500 of the SDF schedule's 700).
-    pub sdf_loss_start: usize,
-    /// `ε` of the SDF loss's projection `v − f ∇f/(|∇f|² + ε)`.
-    pub sdf_loss_epsilon: f64,
-}
-
-impl Default for LossConfig {
-    fn default() -> Self {
-        Self {
-            render_weight: 3.0,
-            planar_weight: 1.0,
-            planar_scale: 500.0,
-            planar_max_samples: roar_loss::planar::DEFAULT_MAX_SAMPLES,
-            planar_neighbours: 10,
-            planar_t2s: true,
-            planar_t2s_max_points: roar_loss::planar::DEFAULT_T2S_MAX_POINTS,
-            render_coarse_resolution: 256,
-            render_coarse_fraction: 1.0,
-            render_coarse_polish: true,
-            sdf_loss_weight: 0.1,
-            sdf_loss_start: 500,
-            sdf_loss_epsilon: 1e-10,
-        }
+config_table! {
+    /// `[loss]`
+    pub struct LossConfig("loss") {
+        /// λ1, the render loss weight (§3.2.3: 3).
+        render_weight: f64 = 3.0, range(0.0, 1e6);
+        /// λ2, the planar projection loss weight (§3.2.3: 1).
+        planar_weight: f64 = 1.0, range(0.0, 1e6);
+        /// Scale of the planar term before its weight (Verification note 2). Measured with
+        /// `crates/roar-cli/examples/loss_balance.rs` on wild meshes' inits at 5k faces: mean per-vertex gradient of
+        /// 3·render ≈ 3.1e-3, raw planar ≈ 1.3e-6–3.1e-6, Laplacian ≈ 3e-4–6e-4; at 500 the planar
+        /// term (6e-4–1.5e-3) is within 5× of the render term instead of 500× below it.
+        planar_scale: f64 = RECONSTRUCTION_PLANAR_SCALE, range(0.0, 1e9);
+        /// Source samples kept per planar loss evaluation (§3.2.2 cap; the default and why:
+        /// `roar_loss::planar::DEFAULT_MAX_SAMPLES`; 50,000 in the SDF and scan schedules).
+        planar_max_samples: usize = DEFAULT_MAX_SAMPLES, range(1.0, 1e8);
+        /// Neighbours of the k-NN planar projection (§8: s2t_neighbours 10).
+        planar_neighbours: usize = KnnOptions::default().k, range(1.0, 100.0);
+        /// Include the target-to-source term (OQ-3).
+        planar_t2s: bool = PlanarOptions::default().t2s;
+        /// Target points the t2s term queries per evaluation, a different spatially even subset
+        /// each time (0: all, the paper's; the default and why:
+        /// `roar_loss::planar::DEFAULT_T2S_MAX_POINTS`; 0 in the SDF and scan schedules).
+        planar_t2s_max_points: usize = DEFAULT_T2S_MAX_POINTS, range(0.0, 1e9);
+        /// Side in pixels of the coarse views the render loss uses for the loop's first
+        /// `render_coarse_fraction` of iterations (and the polish, see `render_coarse_polish`), when
+        /// below `render_resolution`
+        /// (`roar_loss::CoarseViews`; the paper renders every iteration at `render_resolution`,
+        /// `docs/method.md` says why not). Default 256.
+        render_coarse_resolution: u32 = 256, range(16.0, 4096.0);
+        /// Fraction of the loop's iterations rendered at `render_coarse_resolution`, from the
+        /// first (0: none, the paper's schedule). Default 1: the whole loop; 0 in the SDF and scan
+        /// schedules.
+        render_coarse_fraction: f64 = 1.0, range(0.0, 1.0);
+        /// When the whole loop renders at `render_coarse_resolution`, the finish's polish does too
+        /// (false: the polish renders at `render_resolution`). Default true (`docs/method.md` has
+        /// the cost and the fidelity of both).
+        render_coarse_polish: bool = true;
+        /// Weight of the SDF projection loss (§5: 0.1), in the objective only for inputs with a
+        /// signed distance (`roar_loss::SdfLoss`).
+        sdf_loss_weight: f64 = 0.1, range(0.0, 1e6);
+        /// Loop iteration from which the SDF loss is on (§5: 500 of the SDF schedule's 700).
+        sdf_loss_start: usize = SdfLossOptions::default().start_iteration, range(0.0, 1e5);
+        /// `ε` of the SDF loss's projection `v − f ∇f/(|∇f|² + ε)`.
+        sdf_loss_epsilon: f64 = SdfLossOptions::default().epsilon, range(0.0, 1.0);
     }
 }
 
-/// `[optimize]`
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(default, deny_unknown_fields)]
-pub struct OptimizeConfig {
-    /// Move Vertices iterations (§1.2 step 5: 200 for ShapeNet).
-    pub iterations: usize,
-    /// Learning rate η (§3.2.4: 0.05).
-    pub learning_rate: f64,
-    /// Laplacian weight of the optimizer (§8: 0.02).
-    pub laplacian_weight: f64,
-    /// Working budget W = clamp(factor·N, min, max), never below N (OQ-11, §1.2 step 6).
-    /// Defaults: factor 2, min 5000, max 20 000.
-    pub working_budget_factor: usize,
-    /// Lower bound of the working budget.
-    pub working_budget_min: usize,
-    /// Upper bound of the working budget.
-    pub working_budget_max: usize,
-    /// Face Collapse block and flips every this many iterations (§1.3: 1).
-    pub collapse_interval: usize,
-    /// Fold estimator slack (§3.6, note 4: 0.6).
-    pub collapse_fold_slack: f64,
-    /// Spare flagged faces whose vertex-derived normal `|n_o(f)| = |Σ_k n_vk| / 3` is below this,
-    /// unless they fold back onto a neighbour ([SUP] "Collapse Face normal threshold" 0.98,
-    /// §3.6 step 1; note 4 makes it a switch; 0 = off). Vertex normals diverge on a crease or
-    /// on a thin part, where collapsing eats the part from its rim. On by default, measured:
-    /// luke-f-16 at 1000 faces, Chamfer/diag 4.3e-3 without (worse than init + QEM, 1.7e-3),
-    /// 1.24e-3 with; trimesh-rabbit and manifoldplus-chair unchanged or slightly better.
-    pub collapse_min_normal_size: f64,
-    /// Face Split block every this many iterations (§1.3: 10).
-    pub split_interval: usize,
-    /// Face split score threshold per sub-triangle (§3.5, note 1: 0.02).
-    pub split_threshold: f64,
-    /// Tangential smoothing every this many iterations of the loop (§1.3, OQ-13 recommend 5;
-    /// 0 = off, the default). [INF] Off, as in the reference code, whose call site is commented
-    /// out (§3.9): measured at 1000 faces, each sweep raised the render loss by about a quarter
-    /// and the optimizer never caught up (cgal-non_manifold_face_graph: render loss 0.011 at
-    /// iteration 20, 0.064 at 200), and the output was much farther from the input
-    /// (Chamfer/diag every 5 / off: cgal-non_manifold_face_graph 2.71e-3 / 1.84e-3, gc-moebius
-    /// 3.05e-3 / 2.16e-3). The triangles are shaped after the final QEM instead
-    /// (`final_smoothing_sweeps`).
-    pub smoothing_interval: usize,
-    /// Every this many iterations, keep a copy of the loop's mesh and its loss (default 5; 10
-    /// in the SDF and scan schedules; 0 = only the last state). The run finishes from the kept
-    /// state with the lowest loss (the last one included) that the untangle block can clear
-    /// (`run.optimize.finished_from_iteration`, `run.optimize.untangle_failures` in the
-    /// report). [INF] Not in the paper: the blocks make the loss rise as well as fall, and after
-    /// it levels off (by iteration 30–50 on the wild meshes at 1000 faces) it can drift up
-    /// (libigl-camelhead: 0.0486 at iteration 50, 0.0535 at 199); and the last state may be a
-    /// tangle the untangle cannot clear. The loop's stop (`level_window`) is tested at the
-    /// checkpoints, so 5 lets it stop up to 5 iterations sooner (`docs/method.md`); the SDF
-    /// schedule's 700 iterations keep every checkpoint in memory, and 10 halves that.
-    pub checkpoint_interval: usize,
-    /// Stop the loop once its loss has levelled off: at a checkpoint, when no checkpoint of the
-    /// last `level_window` iterations has a loss `level_tolerance` (relative) below the lowest
-    /// one before them (0 = always run `iterations`; needs `checkpoint_interval > 0`).
-    /// Defaults 20 and 0.03 (50 and 0.01 in the scan schedule); off in the SDF schedule, whose
-    /// SDF loss starts at iteration 500.
-    /// [INF] Not in the paper: the run finishes from the lowest-loss checkpoint, and on the wild
-    /// meshes the loss levels off by iteration 50–100 (`docs/method.md`, "The loop stops when its
-    /// loss has levelled off").
-    pub level_window: usize,
-    /// See `level_window`.
-    pub level_tolerance: f64,
-    /// Shorten optimizer steps that would make faces intersect (`roar_ops::untangle::limit_steps`),
-    /// so the loop itself keeps the mesh intersection-free where the blocks did.
-    pub step_limiter: bool,
-    /// Let the blocks skip (collapses, flips) or shorten (smoothing moves) operations that would
-    /// make a face intersect another one (`roar_ops::blocks::guard`), so the loop's mesh stays
-    /// intersection-free and every checkpoint is recent. [INF] Not in the paper. Off by default,
-    /// measured: it keeps folds the Face Collapse block would have removed, and the final
-    /// untangle clears what the unguarded blocks leave (gpytoolbox-airplane at 1000 faces:
-    /// Chamfer/diag 3.49e-3 with it, 2.13e-3 without; luke-f-16 1.92e-3 / 1.88e-3). Worth it
-    /// where the untangle fails and the run would finish from an old checkpoint (a 256-voxel
-    /// init of manifoldplus-chair: the collapse, split and smoothing blocks created crossings in
-    /// 88, 19 and 28 of their calls, and the run fell back to its init).
-    pub guard_intersections: bool,
-    /// The Face Split block of an SDF input projects its samples onto the field (§3.4 C, up to
-    /// 6 gradient evaluations per sample) rather than by the k-NN planar projection over the point
-    /// cloud. The spec's choice and on by default; with a neural field it is most of the run's
-    /// evaluations (`docs/sdf.md`, "Measured cost").
-    pub sdf_split_projector: bool,
-}
-
-impl Default for OptimizeConfig {
-    fn default() -> Self {
-        Self {
-            iterations: 200,
-            learning_rate: 0.05,
-            laplacian_weight: 0.02,
-            working_budget_factor: 2,
-            working_budget_min: 5000,
-            working_budget_max: 20_000,
-            collapse_interval: 1,
-            collapse_fold_slack: 0.6,
-            collapse_min_normal_size: 0.98,
-            split_interval: 10,
-            split_threshold: 0.02,
-            smoothing_interval: 0,
-            checkpoint_interval: 5,
-            level_window: 20,
-            level_tolerance: 0.03,
-            step_limiter: true,
-            guard_intersections: false,
-            sdf_split_projector: true,
-        }
+config_table! {
+    /// `[optimize]`
+    pub struct OptimizeConfig("optimize") {
+        /// Move Vertices iterations (§1.2 step 5: 200 for ShapeNet).
+        iterations: usize = 200, range(0.0, 1e5);
+        /// Learning rate η (§3.2.4: 0.05).
+        learning_rate: f64 = OptimizerOptions::default().lr, range(1e-9, 10.0);
+        /// Laplacian weight of the optimizer (§8: 0.02).
+        laplacian_weight: f64 = OptimizerOptions::default().laplacian_weight, range(0.0, 1e3);
+        /// Working budget W = clamp(factor·N, min, max), never below N (OQ-11, §1.2 step 6).
+        /// Defaults: factor 2, min 5000, max 20 000.
+        working_budget_factor: usize = 2, range(1.0, 100.0);
+        /// Lower bound of the working budget.
+        working_budget_min: usize = 5000, range(4.0, 1e7);
+        /// Upper bound of the working budget.
+        working_budget_max: usize = 20_000, range(4.0, 1e7);
+        /// Face Collapse block and flips every this many iterations (§1.3: 1).
+        collapse_interval: usize = 1, range(0.0, 1e5);
+        /// Fold estimator slack (§3.6, note 4: 0.6).
+        collapse_fold_slack: f64 = FaceCollapseOptions::default().fold_slack, range(0.0, 1.0);
+        /// Spare flagged faces whose vertex-derived normal `|n_o(f)| = |Σ_k n_vk| / 3` is below this,
+        /// unless they fold back onto a neighbour ([SUP] "Collapse Face normal threshold" 0.98,
+        /// §3.6 step 1; note 4 makes it a switch; 0 = off). Vertex normals diverge on a crease or
+        /// on a thin part, where collapsing eats the part from its rim. On by default, measured:
+        /// luke-f-16 at 1000 faces, Chamfer/diag 4.3e-3 without (worse than init + QEM, 1.7e-3),
+        /// 1.24e-3 with; trimesh-rabbit and manifoldplus-chair unchanged or slightly better.
+        collapse_min_normal_size: f64 = 0.98, range(0.0, 1.0);
+        /// Face Split block every this many iterations (§1.3: 10).
+        split_interval: usize = 10, range(0.0, 1e5);
+        /// Face split score threshold per sub-triangle (§3.5, note 1: 0.02).
+        split_threshold: f64 = DEFAULT_SPLIT_THRESHOLD, range(0.0, 1e3);
+        /// Tangential smoothing every this many iterations of the loop (§1.3, OQ-13 recommend 5;
+        /// 0 = off, the default). [INF] Off, as in the reference code, whose call site is commented
+        /// out (§3.9): measured at 1000 faces, each sweep raised the render loss by about a quarter
+        /// and the optimizer never caught up (cgal-non_manifold_face_graph: render loss 0.011 at
+        /// iteration 20, 0.064 at 200), and the output was much farther from the input
+        /// (Chamfer/diag every 5 / off: cgal-non_manifold_face_graph 2.71e-3 / 1.84e-3, gc-moebius
+        /// 3.05e-3 / 2.16e-3). The triangles are shaped after the final QEM instead
+        /// (`final_smoothing_sweeps`).
+        smoothing_interval: usize = 0, range(0.0, 1e5);
+        /// Every this many iterations, keep a copy of the loop's mesh and its loss (default 5; 10
+        /// in the SDF and scan schedules; 0 = only the last state). The run finishes from the kept
+        /// state with the lowest loss (the last one included) that the untangle block can clear
+        /// (`run.optimize.finished_from_iteration`, `run.optimize.untangle_failures` in the
+        /// report). [INF] Not in the paper: the blocks make the loss rise as well as fall, and after
+        /// it levels off (by iteration 30–50 on the wild meshes at 1000 faces) it can drift up
+        /// (libigl-camelhead: 0.0486 at iteration 50, 0.0535 at 199); and the last state may be a
+        /// tangle the untangle cannot clear. The loop's stop (`level_window`) is tested at the
+        /// checkpoints, so 5 lets it stop up to 5 iterations sooner (`docs/method.md`); the SDF
+        /// schedule's 700 iterations keep every checkpoint in memory, and 10 halves that.
+        checkpoint_interval: usize = 5, range(0.0, 1e5);
+        /// Stop the loop once its loss has levelled off: at a checkpoint, when no checkpoint of the
+        /// last `level_window` iterations has a loss `level_tolerance` (relative) below the lowest
+        /// one before them (0 = always run `iterations`; needs `checkpoint_interval > 0`).
+        /// Defaults 20 and 0.03 (50 and 0.01 in the scan schedule); off in the SDF schedule, whose
+        /// SDF loss starts at iteration 500.
+        /// [INF] Not in the paper: the run finishes from the lowest-loss checkpoint, and on the wild
+        /// meshes the loss levels off by iteration 50–100 (`docs/method.md`, "The loop stops when its
+        /// loss has levelled off").
+        level_window: usize = 20, range(0.0, 1e5);
+        /// See `level_window`.
+        level_tolerance: f64 = 0.03, range(0.0, 1.0);
+        /// Shorten optimizer steps that would make faces intersect (`roar_ops::untangle::limit_steps`),
+        /// so the loop itself keeps the mesh intersection-free where the blocks did.
+        step_limiter: bool = true;
+        /// Let the blocks skip (collapses, flips) or shorten (smoothing moves) operations that would
+        /// make a face intersect another one (`roar_ops::blocks::guard`), so the loop's mesh stays
+        /// intersection-free and every checkpoint is recent. [INF] Not in the paper. Off by default,
+        /// measured: it keeps folds the Face Collapse block would have removed, and the final
+        /// untangle clears what the unguarded blocks leave (gpytoolbox-airplane at 1000 faces:
+        /// Chamfer/diag 3.49e-3 with it, 2.13e-3 without; luke-f-16 1.92e-3 / 1.88e-3). Worth it
+        /// where the untangle fails and the run would finish from an old checkpoint (a 256-voxel
+        /// init of manifoldplus-chair: the collapse, split and smoothing blocks created crossings in
+        /// 88, 19 and 28 of their calls, and the run fell back to its init).
+        guard_intersections: bool = false;
+        /// The Face Split block of an SDF input projects its samples onto the field (§3.4 C, up to
+        /// 6 gradient evaluations per sample) rather than by the k-NN planar projection over the point
+        /// cloud. The spec's choice and on by default; with a neural field it is most of the run's
+        /// evaluations (`docs/sdf.md`, "Measured cost").
+        sdf_split_projector: bool = true;
     }
 }
 
-/// `[finish]`
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(default, deny_unknown_fields)]
-pub struct FinishConfig {
-    /// Separation margin of the untangle block, relative to the bounding-box diagonal.
-    pub untangle_margin: f64,
-    /// Before the final QEM, move every vertex this far (relative to the bounding-box diagonal)
-    /// outward along its normal, as far as no intersection appears (default 5e-4; 0 = off; only
-    /// when the polish runs, which moves the vertices back onto the target). [INF] Not in the
-    /// paper: the loop pulls the two sides of a thin part or of an open surface onto one sheet,
-    /// where the QEM's self-intersection veto refuses nearly every collapse and the decimation eats
-    /// the part from its rim instead (libigl-camelhead, an open surface, decimated from its
-    /// 5000-face loop mesh to 1000: 5.9 % of the input farther than 1 % of the diagonal from the
-    /// output, 0.3 % with an offset of 5e-4).
-    pub final_qem_offset: f64,
-    /// Sweeps of tangential smoothing at exactly N after the final QEM, before the polish (default
-    /// 3; 0 = none), each moved vertex put back on its old faces (§3.9 plus projection) and every
-    /// move limited so that no intersection appears. [INF] Not in the paper: with the sweeps off in
-    /// the loop, this is what keeps the output's triangles well shaped. Without it the outputs are
-    /// slightly closer to the input (Chamfer/diag 0.5–1 % lower on gpytoolbox-split_mountain and
-    /// libigl-camelhead at 5000 faces) but worse shaped (median aspect ratio over the 14 wild
-    /// meshes 1.46 with the init at 256 voxels, against 1.26 with the sweeps at 192;
-    /// `docs/method.md`).
-    pub final_smoothing_sweeps: usize,
-    /// Rounds of data-dependent edge flips at exactly N after the smoothing, before the polish
-    /// (default 5; 0 = off): an edge flips when the quad's other diagonal follows the point cloud's
-    /// normals better (`roar_ops::finish::data_flips`), no face gets worse than `Q = 4` (or the
-    /// worse old face) and no intersection appears. [INF] Not in the paper: the valence flips, the
-    /// smoothing and the final QEM choose the diagonals for the triangles' shapes and the working
-    /// mesh's quadrics, not for the target's normals (`docs/method.md`).
-    pub data_flip_rounds: usize,
-    /// Move Vertices iterations at exactly N after the final QEM (default 20; 0 = off), with the
-    /// step limiter, a learning rate falling linearly to 0 and no blocks, so the face count and
-    /// topology stay; the state with the lowest loss is kept. [INF] Not in the paper: the final QEM
-    /// places vertices at quadric minimisers of the working-budget surface, not on the target. If
-    /// the kept mesh intersects itself, the QEM output is kept (the report says so). Runs only when
-    /// `iterations > 0`, so `--iterations 0` stays the plain init + QEM.
-    pub polish_iterations: usize,
-    /// For an input with a signed distance (an SDF), after the polish: this many steps (default
-    /// 3; 0 = off) that move every vertex along its normal by minus the mean first-order distance
-    /// `f/|∇f|` over its faces (sampled at their edge midpoints), except where the move is long
-    /// against its faces, would turn a face over or make faces intersect
-    /// (`roar_ops::finish::zero_set`). [INF] Not in the paper: the loop's mesh is on
-    /// the surface only as far as the losses pull it, and the fill splits to a large budget put
-    /// their vertices on chords (`docs/sdf.md`, "Measured cost"). Soups have no field and skip
-    /// it. Runs only when `iterations > 0`.
-    pub zero_set_steps: usize,
-    /// For an SDF input, before the fit to the zero set: a vertex whose first-order distance
-    /// `|f|/|∇f|` from the zero set exceeds this times its mean edge length is collapsed into a
-    /// neighbour (the nearest to the zero set first) where no face turns over and no
-    /// intersection appears, and the face count is restored by edge splits
-    /// (`roar_ops::finish::fins`; default 0.5; 0 = off). [INF] Not in the paper: the untangle
-    /// can leave fins, flaps of faces standing off the surface that the fit would fold onto
-    /// themselves and so holds (`docs/sdf.md`). Runs only when `iterations > 0`.
-    pub fin_distance_over_edge: f64,
-    /// Last step: flip the edges of faces with aspect ratio `Q = R/(2r)` above this when both faces
-    /// of the edge get better, the two are nearly coplanar (0.95; against the other face alone when
-    /// one is degenerate, above 100) and no intersection appears (`roar_ops::finish::slivers`;
-    /// default 10; 0 = off); then degenerate faces (above 100) that no flip fixes are removed by
-    /// collapsing one of their edges, and the face count is restored by edge splits that make no
-    /// degenerate face (`roar_ops::finish::degenerate`). [INF] Not in the paper: the optimization
-    /// and the polish move vertices for the losses, and the final QEM bounds only the faces it
-    /// creates, so a few caps (one angle near 180°) reach the output. Runs only when `iterations >
-    /// 0`.
-    pub sliver_quality: f64,
-    /// Write the closest mesh when the final QEM cannot reach the budget, instead of failing.
-    pub best_effort: bool,
-    /// Keep the init's genus to the end: when the budget is too small for it (or the final QEM
-    /// stalls on the link condition) the run fails with the QEM's named error instead of
-    /// removing handles (`roar_ops::finish::genus`; DESIGN.md §2).
-    pub keep_topology: bool,
-}
-
-impl Default for FinishConfig {
-    fn default() -> Self {
-        Self {
-            untangle_margin: 1e-6,
-            final_qem_offset: 5e-4,
-            final_smoothing_sweeps: 3,
-            data_flip_rounds: 5,
-            polish_iterations: 20,
-            zero_set_steps: 3,
-            fin_distance_over_edge: 0.5,
-            sliver_quality: 10.0,
-            best_effort: false,
-            keep_topology: false,
-        }
+config_table! {
+    /// `[finish]`
+    pub struct FinishConfig("finish") {
+        /// Separation margin of the untangle block, relative to the bounding-box diagonal.
+        untangle_margin: f64 = UntangleOptions::default().margin_rel, range(0.0, 0.01);
+        /// Before the final QEM, move every vertex this far (relative to the bounding-box diagonal)
+        /// outward along its normal, as far as no intersection appears (default 5e-4; 0 = off; only
+        /// when the polish runs, which moves the vertices back onto the target). [INF] Not in the
+        /// paper: the loop pulls the two sides of a thin part or of an open surface onto one sheet,
+        /// where the QEM's self-intersection veto refuses nearly every collapse and the decimation eats
+        /// the part from its rim instead (libigl-camelhead, an open surface, decimated from its
+        /// 5000-face loop mesh to 1000: 5.9 % of the input farther than 1 % of the diagonal from the
+        /// output, 0.3 % with an offset of 5e-4).
+        final_qem_offset: f64 = 5e-4, range(0.0, 0.1);
+        /// Sweeps of tangential smoothing at exactly N after the final QEM, before the polish (default
+        /// 3; 0 = none), each moved vertex put back on its old faces (§3.9 plus projection) and every
+        /// move limited so that no intersection appears. [INF] Not in the paper: with the sweeps off in
+        /// the loop, this is what keeps the output's triangles well shaped. Without it the outputs are
+        /// slightly closer to the input (Chamfer/diag 0.5–1 % lower on gpytoolbox-split_mountain and
+        /// libigl-camelhead at 5000 faces) but worse shaped (median aspect ratio over the 14 wild
+        /// meshes 1.46 with the init at 256 voxels, against 1.26 with the sweeps at 192;
+        /// `docs/method.md`).
+        final_smoothing_sweeps: usize = 3, range(0.0, 1e3);
+        /// Rounds of data-dependent edge flips at exactly N after the smoothing, before the polish
+        /// (default 5; 0 = off): an edge flips when the quad's other diagonal follows the point cloud's
+        /// normals better (`roar_ops::finish::data_flips`), no face gets worse than `Q = 4` (or the
+        /// worse old face) and no intersection appears. [INF] Not in the paper: the valence flips, the
+        /// smoothing and the final QEM choose the diagonals for the triangles' shapes and the working
+        /// mesh's quadrics, not for the target's normals (`docs/method.md`).
+        data_flip_rounds: usize = DataFlipOptions::default().max_rounds, range(0.0, 1e3);
+        /// Move Vertices iterations at exactly N after the final QEM (default 20; 0 = off), with the
+        /// step limiter, a learning rate falling linearly to 0 and no blocks, so the face count and
+        /// topology stay; the state with the lowest loss is kept. [INF] Not in the paper: the final QEM
+        /// places vertices at quadric minimisers of the working-budget surface, not on the target. If
+        /// the kept mesh intersects itself, the QEM output is kept (the report says so). Runs only when
+        /// `iterations > 0`, so `--iterations 0` stays the plain init + QEM.
+        polish_iterations: usize = 20, range(0.0, 1e5);
+        /// For an input with a signed distance (an SDF), after the polish: this many steps (default
+        /// 3; 0 = off) that move every vertex along its normal by minus the mean first-order distance
+        /// `f/|∇f|` over its faces (sampled at their edge midpoints), except where the move is long
+        /// against its faces, would turn a face over or make faces intersect
+        /// (`roar_ops::finish::zero_set`). [INF] Not in the paper: the loop's mesh is on
+        /// the surface only as far as the losses pull it, and the fill splits to a large budget put
+        /// their vertices on chords (`docs/sdf.md`, "Measured cost"). Soups have no field and skip
+        /// it. Runs only when `iterations > 0`.
+        zero_set_steps: usize = ZeroSetOptions::default().steps, range(0.0, 100.0);
+        /// For an SDF input, before the fit to the zero set: a vertex whose first-order distance
+        /// `|f|/|∇f|` from the zero set exceeds this times its mean edge length is collapsed into a
+        /// neighbour (the nearest to the zero set first) where no face turns over and no
+        /// intersection appears, and the face count is restored by edge splits
+        /// (`roar_ops::finish::fins`; default 0.5; 0 = off). [INF] Not in the paper: the untangle
+        /// can leave fins, flaps of faces standing off the surface that the fit would fold onto
+        /// themselves and so holds (`docs/sdf.md`). Runs only when `iterations > 0`.
+        fin_distance_over_edge: f64 = FinOptions::default().max_distance_over_edge, zero_or(0.01, 100.0);
+        /// Last step: flip the edges of faces with aspect ratio `Q = R/(2r)` above this when both faces
+        /// of the edge get better, the two are nearly coplanar (0.95; against the other face alone when
+        /// one is degenerate, above 100) and no intersection appears (`roar_ops::finish::slivers`;
+        /// default 10; 0 = off); then degenerate faces (above 100) that no flip fixes are removed by
+        /// collapsing one of their edges, and the face count is restored by edge splits that make no
+        /// degenerate face (`roar_ops::finish::degenerate`). [INF] Not in the paper: the optimization
+        /// and the polish move vertices for the losses, and the final QEM bounds only the faces it
+        /// creates, so a few caps (one angle near 180°) reach the output. Runs only when `iterations >
+        /// 0`.
+        sliver_quality: f64 = SliverOptions::default().max_quality, zero_or(1.0, 1e6);
+        /// Write the closest mesh when the final QEM cannot reach the budget, instead of failing.
+        best_effort: bool = false;
+        /// Keep the init's genus to the end: when the budget is too small for it (or the final QEM
+        /// stalls on the link condition) the run fails with the QEM's named error instead of
+        /// removing handles (`roar_ops::finish::genus`; DESIGN.md §2).
+        keep_topology: bool = false;
     }
 }
 
@@ -544,209 +558,19 @@ impl ReconstructConfig {
     /// weights, zero samples, huge values that would exhaust memory or time), not what is merely
     /// unusual. `0 (off)` marks the fields where 0 switches a feature off, as their docs say.
     pub fn field_ranges(&self) -> Vec<(FieldRange, f64)> {
-        let r = FieldRange::new;
-        let off = FieldRange::zero_or;
-        vec![
-            (r("faces", 4.0, 1e9), self.faces as f64),
-            (r("seed", 0.0, u64::MAX as f64), self.seed as f64),
+        let mut ranges = vec![
+            (FieldRange::new("faces", 4.0, 1e9), self.faces as f64),
             (
-                r("optimize.iterations", 0.0, 1e5),
-                self.optimize.iterations as f64,
+                FieldRange::new("seed", 0.0, u64::MAX as f64),
+                self.seed as f64,
             ),
-            (
-                r("init.init_resolution", 8.0, 1024.0),
-                self.init.init_resolution as f64,
-            ),
-            (
-                r("init.init_max_faces", 4.0, 1e7),
-                self.init.init_max_faces as f64,
-            ),
-            (
-                off("init.enclosure_winding_threshold", 0.5, 1.0),
-                self.init.enclosure_winding_threshold,
-            ),
-            (
-                r("init.enclosure_max_cap_fraction", 0.0, 1.0),
-                self.init.enclosure_max_cap_fraction,
-            ),
-            (
-                r("init.sphere_level", 0.0, 8.0),
-                f64::from(self.init.sphere_level),
-            ),
-            (
-                r("target.scan_max_edge_factor", 1.0, 1e3),
-                self.target.scan_max_edge_factor,
-            ),
-            (
-                r("target.scan_max_angle_degrees", 1.0, 90.0),
-                self.target.scan_max_angle_degrees,
-            ),
-            (
-                r("optimize.working_budget_factor", 1.0, 100.0),
-                self.optimize.working_budget_factor as f64,
-            ),
-            (
-                r("optimize.working_budget_min", 4.0, 1e7),
-                self.optimize.working_budget_min as f64,
-            ),
-            (
-                r("optimize.working_budget_max", 4.0, 1e7),
-                self.optimize.working_budget_max as f64,
-            ),
-            (
-                r("target.views_per_axis", 1.0, 32.0),
-                self.target.views_per_axis as f64,
-            ),
-            (
-                r("target.render_resolution", 16.0, 4096.0),
-                f64::from(self.target.render_resolution),
-            ),
-            (r("target.twin_ratio", 1.0, 1e6), self.target.twin_ratio),
-            (r("loss.render_weight", 0.0, 1e6), self.loss.render_weight),
-            (
-                r("loss.render_coarse_resolution", 16.0, 4096.0),
-                f64::from(self.loss.render_coarse_resolution),
-            ),
-            (
-                r("loss.render_coarse_fraction", 0.0, 1.0),
-                self.loss.render_coarse_fraction,
-            ),
-            (r("loss.planar_weight", 0.0, 1e6), self.loss.planar_weight),
-            (r("loss.planar_scale", 0.0, 1e9), self.loss.planar_scale),
-            (
-                r("loss.planar_max_samples", 1.0, 1e8),
-                self.loss.planar_max_samples as f64,
-            ),
-            (
-                r("loss.planar_neighbours", 1.0, 100.0),
-                self.loss.planar_neighbours as f64,
-            ),
-            (
-                r("loss.planar_t2s_max_points", 0.0, 1e9),
-                self.loss.planar_t2s_max_points as f64,
-            ),
-            (
-                r("target.point_cloud_samples", 100.0, 5e7),
-                self.target.point_cloud_samples as f64,
-            ),
-            (
-                r("target.winding_threshold", 1e-6, 1.0),
-                self.target.winding_threshold,
-            ),
-            (r("target.sheet_offset", 0.0, 0.1), self.target.sheet_offset),
-            (
-                r("target.sharp_edge_samples", 0.0, 5e7),
-                self.target.sharp_edge_samples as f64,
-            ),
-            (
-                r("optimize.learning_rate", 1e-9, 10.0),
-                self.optimize.learning_rate,
-            ),
-            (
-                r("optimize.laplacian_weight", 0.0, 1e3),
-                self.optimize.laplacian_weight,
-            ),
-            (
-                r("optimize.collapse_interval", 0.0, 1e5),
-                self.optimize.collapse_interval as f64,
-            ),
-            (
-                r("optimize.collapse_fold_slack", 0.0, 1.0),
-                self.optimize.collapse_fold_slack,
-            ),
-            (
-                r("optimize.collapse_min_normal_size", 0.0, 1.0),
-                self.optimize.collapse_min_normal_size,
-            ),
-            (
-                r("optimize.split_interval", 0.0, 1e5),
-                self.optimize.split_interval as f64,
-            ),
-            (
-                r("optimize.split_threshold", 0.0, 1e3),
-                self.optimize.split_threshold,
-            ),
-            (
-                r("optimize.smoothing_interval", 0.0, 1e5),
-                self.optimize.smoothing_interval as f64,
-            ),
-            (
-                r("finish.final_smoothing_sweeps", 0.0, 1e3),
-                self.finish.final_smoothing_sweeps as f64,
-            ),
-            (
-                r("finish.data_flip_rounds", 0.0, 1e3),
-                self.finish.data_flip_rounds as f64,
-            ),
-            (
-                r("optimize.checkpoint_interval", 0.0, 1e5),
-                self.optimize.checkpoint_interval as f64,
-            ),
-            (
-                r("optimize.level_window", 0.0, 1e5),
-                self.optimize.level_window as f64,
-            ),
-            (
-                r("optimize.level_tolerance", 0.0, 1.0),
-                self.optimize.level_tolerance,
-            ),
-            (
-                r("finish.untangle_margin", 0.0, 0.01),
-                self.finish.untangle_margin,
-            ),
-            (
-                r("finish.final_qem_offset", 0.0, 0.1),
-                self.finish.final_qem_offset,
-            ),
-            (
-                r("finish.polish_iterations", 0.0, 1e5),
-                self.finish.polish_iterations as f64,
-            ),
-            (
-                r("finish.zero_set_steps", 0.0, 100.0),
-                self.finish.zero_set_steps as f64,
-            ),
-            (
-                off("finish.fin_distance_over_edge", 0.01, 100.0),
-                self.finish.fin_distance_over_edge,
-            ),
-            (
-                off("finish.sliver_quality", 1.0, 1e6),
-                self.finish.sliver_quality,
-            ),
-            (
-                r("loss.sdf_loss_weight", 0.0, 1e6),
-                self.loss.sdf_loss_weight,
-            ),
-            (
-                r("loss.sdf_loss_start", 0.0, 1e5),
-                self.loss.sdf_loss_start as f64,
-            ),
-            (
-                r("loss.sdf_loss_epsilon", 0.0, 1.0),
-                self.loss.sdf_loss_epsilon,
-            ),
-            (
-                r("init.sdf_init_resolution", 2.0, 1024.0),
-                self.init.sdf_init_resolution as f64,
-            ),
-            (
-                r("target.sdf_trace_grid", 2.0, 2048.0),
-                self.target.sdf_trace_grid as f64,
-            ),
-            (
-                r("target.sdf_trace_refine_steps", 0.0, 100.0),
-                self.target.sdf_trace_refine_steps as f64,
-            ),
-            (
-                r("target.sdf_projection_steps", 1.0, 100.0),
-                self.target.sdf_projection_steps as f64,
-            ),
-            (
-                r("target.sdf_projection_tolerance", 1e-12, 1.0),
-                self.target.sdf_projection_tolerance,
-            ),
-        ]
+        ];
+        ranges.extend(self.target.field_ranges());
+        ranges.extend(self.init.field_ranges());
+        ranges.extend(self.loss.field_ranges());
+        ranges.extend(self.optimize.field_ranges());
+        ranges.extend(self.finish.field_ranges());
+        ranges
     }
 }
 
