@@ -1,6 +1,9 @@
-//! The reconstruction's configuration: every hyper-parameter of the spec with the paper's
-//! default, each documented with the section of `spec/roar-method.md` it comes from. A TOML
-//! file overrides any subset (unknown keys are errors); the CLI's flags override the file.
+//! The reconstruction's configuration: every knob of `roar reconstruct`, in the TOML tables
+//! `[target]`, `[init]`, `[loss]`, `[optimize]` and `[finish]`. A TOML file (or the Python
+//! package's dict) overrides any subset (unknown keys are errors); the CLI's flags override the
+//! file. Each field is declared once, with its doc, type, default and allowed range
+//! (`config_table!`); where a library's `Options::default()` holds the same knob, the default is
+//! read from there. Why each default: `docs/method.md`, defaults table.
 
 use roar_io::PatchOptions;
 use roar_loss::planar::{DEFAULT_MAX_SAMPLES, DEFAULT_T2S_MAX_POINTS, RECONSTRUCTION_PLANAR_SCALE};
@@ -45,7 +48,10 @@ macro_rules! config_table {
                 #[doc = ""]
                 #[doc = concat!(
                     "Default: `", stringify!($default), "`",
-                    $("; allowed: `", stringify!($kind($min, $max)), "`",)?
+                    $(
+                        "; allowed: `", stringify!($kind), "(", stringify!($min), ", ",
+                        stringify!($max), ")`",
+                    )?
                     "."
                 )]
                 pub $field: $ty,
@@ -115,46 +121,45 @@ impl RangeValue for usize {
     }
 }
 
-/// The enclosure rule's threshold for scan sets (`enclosure_winding_threshold` of
-/// `ReconstructConfig::scan_defaults`), below the
-/// soups' `roar_ops::init::ENCLOSURE_WINDING_THRESHOLD` (0.7) because scans leave wider
-/// openings: four bunny scans around its side (bun000, bun090, bun180, bun270; top and base
-/// unscanned) give an init of genus 1 at 0.7 (a tunnel from top to base) and of genus 0 at 0.6
-/// and 0.5.
+/// The enclosure rule's threshold for scan sets (`init.enclosure_winding_threshold` of
+/// [`ReconstructConfig::scan_defaults`]), below the soups'
+/// `roar_ops::init::ENCLOSURE_WINDING_THRESHOLD` (0.7): scans leave wider openings than soups'
+/// punctures, and at the soups' threshold the init can keep a tunnel through the parts the
+/// scanner never saw (why: `docs/scans.md`).
 pub const SCAN_ENCLOSURE_WINDING_THRESHOLD: f64 = 0.6;
 
-/// How the initial mesh M0 is made (spec §4).
+/// How the initial mesh M0 is made.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum InitKind {
     /// The input shape's own initial mesh (`Shape::initial_mesh`): for a soup the watertight
-    /// voxel init of the cleaned target, in the manner of Manifold (§4.1).
+    /// voxel init of the cleaned target, in the manner of Manifold.
     Watertight,
-    /// An icosphere of radius 0.5 (§4.2); its genus is 0, so holes of the input are lost.
+    /// An icosphere of radius 0.5; its genus is 0, so holes of the input are lost.
     Sphere,
 }
 
 /// Every knob of `roar reconstruct`, grouped by the pipeline stage that reads it: the TOML file
 /// has the tables `[target]`, `[init]`, `[loss]`, `[optimize]` and `[finish]` (`--print-config`
-/// prints them all). Where a field's doc names its default (or `docs/method.md` does), the unit
-/// test `documented_defaults` checks that the code agrees.
+/// prints them all). The unit test `documented_defaults` checks the defaults that
+/// `docs/method.md`'s defaults table states.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct ReconstructConfig {
-    /// Exact face count of the output (even). §1.1 "face budget B".
+    /// Exact face count of the output (even).
     pub faces: usize,
-    /// Seed of every random choice (§10: seed 43).
+    /// Seed of every random choice.
     pub seed: u64,
-    /// The target T′ (§3.1): the rig it is rendered with, its point cloud, and how scans and
-    /// signed distances are read into it.
+    /// The target T′: the rig it is rendered with, its point cloud, and how scans and signed
+    /// distances are read into it.
     pub target: TargetConfig,
-    /// The initial mesh M0 (§4).
+    /// The initial mesh M0.
     pub init: InitConfig,
-    /// The loss the loop minimises (§3.2).
+    /// The loss the loop minimises.
     pub loss: LossConfig,
-    /// The loop (§1.2): Move Vertices and its blocks, at the working budget.
+    /// The loop: Move Vertices and its remeshing blocks, at the working budget.
     pub optimize: OptimizeConfig,
-    /// From the loop's mesh to exactly N faces (§1.2 step 7 and the steps after it).
+    /// From the loop's mesh to exactly `faces` faces.
     pub finish: FinishConfig,
 }
 
@@ -173,293 +178,273 @@ impl Default for ReconstructConfig {
 }
 
 config_table! {
-    /// `[target]`
+    /// `[target]`: the target T′ the loop fits, its renders and its point cloud.
     pub struct TargetConfig("target") {
-        /// Views per axis of the star rig: n² views (§3.2.1: 6 → 36). Default 5 (25 views); 6 in
-        /// the SDF and scan schedules. [INF] Fewer views than the paper: each loop iteration
-        /// renders 31 % fewer pixels and the loop levels off sooner, for a Chamfer distance within
-        /// 0.2 % (median) of 36 views on the wild meshes (`docs/method.md`, "The rig has 25 views").
+        /// Views per axis of the star rig: n² views (6 in the SDF and scan schedules).
+        /// `roar_loss::TargetOptions` keeps the paper's 6 (36 views); the pipeline renders 25, so
+        /// each loop iteration renders fewer pixels (why: `docs/method.md`, defaults table).
         views_per_axis: usize = 5, range(1.0, 32.0);
-        /// Render resolution in pixels (§3.2.1: 512).
+        /// Render resolution in pixels of the target renders (and of the loop's views when they
+        /// are not coarse, see `loss.render_coarse_resolution`).
         render_resolution: u32 = TargetOptions::default().resolution, range(16.0, 4096.0);
-        /// Keep both twins of a soup face unless one has this many times more pixels (§3.1 a: 80).
+        /// Keep both twins of a soup face unless one has this many times more pixels.
         twin_ratio: f64 = TargetOptions::default().twin_ratio, range(1.0, 1e6);
-        /// Target point cloud samples (§3.1 b: 200k).
+        /// Samples of the target point cloud.
         point_cloud_samples: usize = PointCloudOptions::default().samples, range(100.0, 5e7);
-        /// Keep target samples whose winding number at p + 1e-3·n is below this (§3.1 b, OQ-14).
+        /// Keep target samples whose winding number at p + 1e-3·n is below this.
         winding_threshold: f64 = PointCloudOptions::default().winding_threshold, range(1e-6, 1.0);
-        /// Target samples on a sheet (a face of T′ whose reversed twin is kept too: an open surface
-        /// or a zero-thickness part) stand off it by this much along their normal, relative to the
-        /// bounding-box diagonal, so the two sides of the closed output each get their own plane
-        /// instead of jamming against each other on one (0 = off). [INF] Not in the paper; the
-        /// value is the offset CGAL's alpha wrap is run with in the evaluation (`roar_loss::
-        /// point_cloud` explains the jam; at 5000 faces the normal cosine rose on every sheet of the
-        /// evaluation, the Chamfer distance grew on closely fitted ones: `docs/method.md`, "Sheets get
-        /// one plane per side").
+        /// Target samples on a sheet (a face of T′ whose reversed twin is kept too: an open
+        /// surface or a zero-thickness part) stand off it by this much along their normal,
+        /// relative to the bounding-box diagonal, so the two sides of the closed output each get
+        /// their own plane instead of jamming against each other on one (0 = off). Not in the
+        /// paper. The library's `PointCloudOptions::sheet_offset` is absolute and off; the
+        /// pipeline's is relative and on (why: `docs/method.md`, defaults table).
         sheet_offset: f64 = 1e-3, range(0.0, 0.1);
-        /// Sharp-edge samples from the init (§3.1 c: 30k).
+        /// Samples on the sharp edges of the init, added to the target point cloud (0 = none).
         sharp_edge_samples: usize = SharpEdgeOptions::default().samples, range(0.0, 5e7);
         /// Range scans: a patch triangle with an edge longer than this many times the local grid
-        /// spacing bridges a depth jump and is dropped (`roar_io::PatchOptions::max_edge_factor`,
-        /// where the default is measured).
+        /// spacing bridges a depth jump and is dropped.
         scan_max_edge_factor: f64 = PatchOptions::default().max_edge_factor, range(1.0, 1e3);
         /// Range scans: a patch triangle whose normal is more than this many degrees from the
-        /// direction to the scanner is dropped (`roar_io::PatchOptions::max_angle_degrees`).
+        /// direction to the scanner is dropped.
         scan_max_angle_degrees: f64 = PatchOptions::default().max_angle_degrees, range(1.0, 90.0);
-        /// Range scans: refine the `.conf` poses by ICP (`roar_ops::align`); `--no-icp` turns it off.
+        /// Range scans: refine the `.conf` poses by ICP (`roar_ops::align`); `--no-icp` turns it
+        /// off.
         scan_icp: bool = true;
         /// Cells of the grid that brackets the zero set for an SDF input's traced target renders
         /// (`roar_sdf::trace`): features thinner than about one cell can be missed.
         sdf_trace_grid: usize = TraceOptions::default().grid_resolution, range(2.0, 2048.0);
         /// Regula falsi steps per traced pixel of an SDF input.
         sdf_trace_refine_steps: usize = TraceOptions::default().refine_steps, range(0.0, 100.0);
-        /// First-order steps of an SDF input's projections: the Face Split projector (§3.4 C: 5)
-        /// and the point-cloud samples.
+        /// First-order steps of an SDF input's projections: the Face Split projector and the
+        /// point-cloud samples.
         sdf_projection_steps: usize = SdfProjectorOptions::default().steps, range(1.0, 100.0);
-        /// A projected sample of an SDF input is valid when its first-order distance `|f|/|∇f|` ends
-        /// at most this, in rig units (§3.4 C: 1e-6 for float64 fields; f32 networks need more).
-        sdf_projection_tolerance: f64 = SdfProjectorOptions::default().tolerance, range(1e-12, 1.0);
+        /// A projected sample of an SDF input is valid when its first-order distance `|f|/|∇f|`
+        /// ends at most this, in rig units. Looser than the paper's 1e-6, which float64 fields
+        /// reach but float32 networks do not.
+        sdf_projection_tolerance: f64 = SdfProjectorOptions::default().tolerance,
+            range(1e-12, 1.0);
     }
 }
 
 config_table! {
-    /// `[init]`
+    /// `[init]`: the initial mesh M0.
     pub struct InitConfig("init") {
-        /// Initial mesh (§4).
+        /// Initial mesh.
         kind: InitKind = InitKind::Watertight;
-        /// Voxels along the longest axis of the watertight init (replaces Manifold's octree
-        /// resolution, OQ-12). The init closes gaps of one voxel and the loop never changes the
-        /// genus, so this decides which slots and holes of the input survive: 192 keeps gaps down to
-        /// about diag/170 on a box-like shape, on a par with alpha wrapping at α = diag/300, where
-        /// `roar init`'s 128 fills the slots between a chair's slats. 256 opens narrower cavities
-        /// (libigl-camelhead's ears) and costs 3–5 s more on the wild meshes, but gains less than it
-        /// gives roar's own init + QEM (`docs/method.md`).
+        /// Voxels along the longest axis of the watertight init (in place of Manifold's octree
+        /// resolution). The init closes gaps of about one voxel and the loop never changes the
+        /// genus, so this decides which slots and holes of the input survive. Above `roar
+        /// init`'s 128 (`roar_ops::init::InitOptions::default()`), which fills slots a
+        /// reconstruction should keep, such as those between a chair's slats (why:
+        /// `docs/method.md`, defaults table).
         init_resolution: usize = 192, range(8.0, 1024.0);
-        /// The init is decimated to at most this many faces (§4.1: 20k).
+        /// The init is decimated to at most this many faces.
         init_max_faces: usize = InitialMeshOptions::default().max_faces, range(4.0, 1e7);
         /// Enclosure rule of the watertight init (`roar_ops::init::winding_solid`; 0 = off):
-        /// exterior voxels whose generalized winding number with respect to T′ is above this value
-        /// turn solid, so punctures of a closed surface close while tunnels stay. Default
-        /// `roar_ops::init::ENCLOSURE_WINDING_THRESHOLD` (0.7).
+        /// exterior voxels whose generalized winding number with respect to T′ is above this
+        /// value turn solid, so punctures of a closed surface close while tunnels stay.
         enclosure_winding_threshold: f64 = ENCLOSURE_WINDING_THRESHOLD, zero_or(0.5, 1.0);
         /// A region the enclosure rule fills stays filled only if its widest cap (a patch of its
         /// boundary no input surface covers) is at most this fraction of its boundary: punctures
-        /// close, the wide opening of an open surface stays open. Default
-        /// `roar_ops::init::ENCLOSURE_MAX_CAP_FRACTION` (0.02); 1 closes every opening.
+        /// close, the wide opening of an open surface stays open (1 closes every opening).
         enclosure_max_cap_fraction: f64 = ENCLOSURE_MAX_CAP_FRACTION, range(0.0, 1.0);
-        /// Subdivision level of the sphere init. Default 4 (§4.2 has 2; more helps a sphere reach
-        /// detail).
+        /// Subdivision level of the sphere init. Finer than the paper's level 2, so that a sphere
+        /// can reach detail.
         sphere_level: u32 = 4, range(0.0, 8.0);
-        /// Cells along the longest side of an SDF input's bounds for its voxel init (§4.3: 64).
+        /// Cells along the longest side of an SDF input's bounds for its voxel init.
         sdf_init_resolution: usize = SdfInitOptions::default().resolution, range(2.0, 1024.0);
     }
 }
 
 config_table! {
-    /// `[loss]`
+    /// `[loss]`: the loss the loop minimises.
     pub struct LossConfig("loss") {
-        /// λ1, the render loss weight (§3.2.3: 3).
+        /// λ1, the weight of the render loss.
         render_weight: f64 = 3.0, range(0.0, 1e6);
-        /// λ2, the planar projection loss weight (§3.2.3: 1).
+        /// λ2, the weight of the planar projection loss.
         planar_weight: f64 = 1.0, range(0.0, 1e6);
-        /// Scale of the planar term before its weight (Verification note 2). Measured with
-        /// `crates/roar-cli/examples/loss_balance.rs` on wild meshes' inits at 5k faces: mean per-vertex gradient of
-        /// 3·render ≈ 3.1e-3, raw planar ≈ 1.3e-6–3.1e-6, Laplacian ≈ 3e-4–6e-4; at 500 the planar
-        /// term (6e-4–1.5e-3) is within 5× of the render term instead of 500× below it.
+        /// Scale of the planar term before its weight. The library's `PlanarOptions::default()`
+        /// scale (`SPHERE_BALANCED_PLANAR_SCALE`, 5) balances the terms on a sphere; on a real
+        /// input's init the raw planar gradient is far smaller against the render gradient
+        /// (why: `docs/method.md`, defaults table).
         planar_scale: f64 = RECONSTRUCTION_PLANAR_SCALE, range(0.0, 1e9);
-        /// Source samples kept per planar loss evaluation (§3.2.2 cap; the default and why:
-        /// `roar_loss::planar::DEFAULT_MAX_SAMPLES`; 50,000 in the SDF and scan schedules).
+        /// Source samples kept per planar loss evaluation (50,000 in the SDF and scan
+        /// schedules). The paper samples at a fixed density without a cap (why:
+        /// `docs/method.md`, defaults table).
         planar_max_samples: usize = DEFAULT_MAX_SAMPLES, range(1.0, 1e8);
-        /// Neighbours of the k-NN planar projection (§8: s2t_neighbours 10).
+        /// Neighbours of the k-NN planar projection.
         planar_neighbours: usize = KnnOptions::default().k, range(1.0, 100.0);
-        /// Include the target-to-source term (OQ-3).
+        /// Include the target-to-source (t2s) term of the planar loss.
         planar_t2s: bool = PlanarOptions::default().t2s;
         /// Target points the t2s term queries per evaluation, a different spatially even subset
-        /// each time (0: all, the paper's; the default and why:
-        /// `roar_loss::planar::DEFAULT_T2S_MAX_POINTS`; 0 in the SDF and scan schedules).
+        /// each time (0 = all, as the paper does; 0 in the SDF and scan schedules) (why:
+        /// `docs/method.md`, defaults table).
         planar_t2s_max_points: usize = DEFAULT_T2S_MAX_POINTS, range(0.0, 1e9);
         /// Side in pixels of the coarse views the render loss uses for the loop's first
-        /// `render_coarse_fraction` of iterations (and the polish, see `render_coarse_polish`), when
-        /// below `render_resolution`
-        /// (`roar_loss::CoarseViews`; the paper renders every iteration at `render_resolution`,
-        /// `docs/method.md` says why not). Default 256.
+        /// `render_coarse_fraction` of iterations (and the polish, see `render_coarse_polish`),
+        /// when below `target.render_resolution` (`roar_loss::CoarseViews`). The paper renders
+        /// every iteration at full resolution; roar does not (why: `docs/method.md`, defaults
+        /// table).
         render_coarse_resolution: u32 = 256, range(16.0, 4096.0);
         /// Fraction of the loop's iterations rendered at `render_coarse_resolution`, from the
-        /// first (0: none, the paper's schedule). Default 1: the whole loop; 0 in the SDF and scan
-        /// schedules.
+        /// first (0 = none, the paper's schedule, and the SDF and scan schedules'; 1 = the whole
+        /// loop).
         render_coarse_fraction: f64 = 1.0, range(0.0, 1.0);
-        /// When the whole loop renders at `render_coarse_resolution`, the finish's polish does too
-        /// (false: the polish renders at `render_resolution`). Default true (`docs/method.md` has
-        /// the cost and the fidelity of both).
+        /// When the whole loop renders at `render_coarse_resolution`, the finish's polish does
+        /// too (false: the polish renders at `target.render_resolution`) (why: `docs/method.md`,
+        /// defaults table).
         render_coarse_polish: bool = true;
-        /// Weight of the SDF projection loss (§5: 0.1), in the objective only for inputs with a
-        /// signed distance (`roar_loss::SdfLoss`).
+        /// Weight of the SDF projection loss, in the objective only for inputs with a signed
+        /// distance (`roar_loss::SdfLoss`).
         sdf_loss_weight: f64 = 0.1, range(0.0, 1e6);
-        /// Loop iteration from which the SDF loss is on (§5: 500 of the SDF schedule's 700).
+        /// Loop iteration from which the SDF loss is on.
         sdf_loss_start: usize = SdfLossOptions::default().start_iteration, range(0.0, 1e5);
-        /// `ε` of the SDF loss's projection `v − f ∇f/(|∇f|² + ε)`.
+        /// `ε` of the SDF loss's projection `v − f ∇f/(|∇f|² + ε)`, and of the finish's
+        /// first-order distances to the zero set.
         sdf_loss_epsilon: f64 = SdfLossOptions::default().epsilon, range(0.0, 1.0);
     }
 }
 
 config_table! {
-    /// `[optimize]`
+    /// `[optimize]`: the loop, Move Vertices and its remeshing blocks at the working budget.
     pub struct OptimizeConfig("optimize") {
-        /// Move Vertices iterations (§1.2 step 5: 200 for ShapeNet).
+        /// Move Vertices iterations of the loop.
         iterations: usize = 200, range(0.0, 1e5);
-        /// Learning rate η (§3.2.4: 0.05).
+        /// Learning rate η of the optimizer.
         learning_rate: f64 = OptimizerOptions::default().lr, range(1e-9, 10.0);
-        /// Laplacian weight of the optimizer (§8: 0.02).
+        /// Weight of the optimizer's Laplacian term.
         laplacian_weight: f64 = OptimizerOptions::default().laplacian_weight, range(0.0, 1e3);
-        /// Working budget W = clamp(factor·N, min, max), never below N (OQ-11, §1.2 step 6).
-        /// Defaults: factor 2, min 5000, max 20 000.
+        /// The working budget, the face count the loop works at, is W = clamp(factor·N, min,
+        /// max), never below N.
         working_budget_factor: usize = 2, range(1.0, 100.0);
         /// Lower bound of the working budget.
         working_budget_min: usize = 5000, range(4.0, 1e7);
         /// Upper bound of the working budget.
         working_budget_max: usize = 20_000, range(4.0, 1e7);
-        /// Face Collapse block and flips every this many iterations (§1.3: 1).
+        /// Face Collapse block and its valence flips every this many iterations (0 = never).
         collapse_interval: usize = 1, range(0.0, 1e5);
-        /// Fold estimator slack (§3.6, note 4: 0.6).
+        /// Slack of the Face Collapse block's fold estimator.
         collapse_fold_slack: f64 = FaceCollapseOptions::default().fold_slack, range(0.0, 1.0);
-        /// Spare flagged faces whose vertex-derived normal `|n_o(f)| = |Σ_k n_vk| / 3` is below this,
-        /// unless they fold back onto a neighbour ([SUP] "Collapse Face normal threshold" 0.98,
-        /// §3.6 step 1; note 4 makes it a switch; 0 = off). Vertex normals diverge on a crease or
-        /// on a thin part, where collapsing eats the part from its rim. On by default, measured:
-        /// luke-f-16 at 1000 faces, Chamfer/diag 4.3e-3 without (worse than init + QEM, 1.7e-3),
-        /// 1.24e-3 with; trimesh-rabbit and manifoldplus-chair unchanged or slightly better.
+        /// Spare flagged faces whose vertex-derived normal `|n_o(f)| = |Σ_k n_vk| / 3` is below
+        /// this, unless they fold back onto a neighbour (0 = off). Vertex normals diverge on a
+        /// crease or on a thin part, where collapsing eats the part from its rim. Off in the
+        /// library's `FaceCollapseOptions::default()`, on in the pipeline at the threshold of the
+        /// paper's supplement (why: `docs/method.md`, defaults table).
         collapse_min_normal_size: f64 = 0.98, range(0.0, 1.0);
-        /// Face Split block every this many iterations (§1.3: 10).
+        /// Face Split block every this many iterations, never at the first (0 = never).
         split_interval: usize = 10, range(0.0, 1e5);
-        /// Face split score threshold per sub-triangle (§3.5, note 1: 0.02).
+        /// Face Split score threshold per sub-triangle.
         split_threshold: f64 = DEFAULT_SPLIT_THRESHOLD, range(0.0, 1e3);
-        /// Tangential smoothing every this many iterations of the loop (§1.3, OQ-13 recommend 5;
-        /// 0 = off, the default). [INF] Off, as in the reference code, whose call site is commented
-        /// out (§3.9): measured at 1000 faces, each sweep raised the render loss by about a quarter
-        /// and the optimizer never caught up (cgal-non_manifold_face_graph: render loss 0.011 at
-        /// iteration 20, 0.064 at 200), and the output was much farther from the input
-        /// (Chamfer/diag every 5 / off: cgal-non_manifold_face_graph 2.71e-3 / 1.84e-3, gc-moebius
-        /// 3.05e-3 / 2.16e-3). The triangles are shaped after the final QEM instead
-        /// (`final_smoothing_sweeps`).
+        /// Tangential smoothing every this many iterations of the loop (0 = off). The paper
+        /// recommends 5 but its reference code never calls it; roar follows the code and shapes
+        /// the triangles after the final QEM instead (`finish.final_smoothing_sweeps`) (why:
+        /// `docs/method.md`, defaults table).
         smoothing_interval: usize = 0, range(0.0, 1e5);
-        /// Every this many iterations, keep a copy of the loop's mesh and its loss (default 5; 10
-        /// in the SDF and scan schedules; 0 = only the last state). The run finishes from the kept
-        /// state with the lowest loss (the last one included) that the untangle block can clear
+        /// Every this many iterations, keep a copy of the loop's mesh and its loss (0 = only the
+        /// last state; 10 in the SDF and scan schedules). The run finishes from the kept state
+        /// with the lowest loss (the last one included) that the untangle block can clear
         /// (`run.optimize.finished_from_iteration`, `run.optimize.untangle_failures` in the
-        /// report). [INF] Not in the paper: the blocks make the loss rise as well as fall, and after
-        /// it levels off (by iteration 30–50 on the wild meshes at 1000 faces) it can drift up
-        /// (libigl-camelhead: 0.0486 at iteration 50, 0.0535 at 199); and the last state may be a
-        /// tangle the untangle cannot clear. The loop's stop (`level_window`) is tested at the
-        /// checkpoints, so 5 lets it stop up to 5 iterations sooner (`docs/method.md`); the SDF
-        /// schedule's 700 iterations keep every checkpoint in memory, and 10 halves that.
+        /// report), and the loop's stop (`level_window`) is tested at the checkpoints. The paper
+        /// finishes from the last state (why: `docs/method.md`, defaults table).
         checkpoint_interval: usize = 5, range(0.0, 1e5);
-        /// Stop the loop once its loss has levelled off: at a checkpoint, when no checkpoint of the
-        /// last `level_window` iterations has a loss `level_tolerance` (relative) below the lowest
-        /// one before them (0 = always run `iterations`; needs `checkpoint_interval > 0`).
-        /// Defaults 20 and 0.03 (50 and 0.01 in the scan schedule); off in the SDF schedule, whose
-        /// SDF loss starts at iteration 500.
-        /// [INF] Not in the paper: the run finishes from the lowest-loss checkpoint, and on the wild
-        /// meshes the loss levels off by iteration 50–100 (`docs/method.md`, "The loop stops when its
-        /// loss has levelled off").
+        /// Stop the loop once its loss has levelled off: at a checkpoint, when no checkpoint of
+        /// the last `level_window` iterations has a loss `level_tolerance` (relative) below the
+        /// lowest one before them (0 = always run `iterations`; needs `checkpoint_interval > 0`;
+        /// 50 in the scan schedule, 0 in the SDF schedule, whose SDF loss starts late). The paper
+        /// always runs every iteration (why: `docs/method.md`, defaults table).
         level_window: usize = 20, range(0.0, 1e5);
-        /// See `level_window`.
+        /// See `level_window` (0.01 in the scan schedule).
         level_tolerance: f64 = 0.03, range(0.0, 1.0);
-        /// Shorten optimizer steps that would make faces intersect (`roar_ops::untangle::limit_steps`),
-        /// so the loop itself keeps the mesh intersection-free where the blocks did.
+        /// Shorten optimizer steps that would make faces intersect
+        /// (`roar_ops::untangle::limit_steps`), so the loop itself keeps the mesh
+        /// intersection-free where the blocks did.
         step_limiter: bool = true;
-        /// Let the blocks skip (collapses, flips) or shorten (smoothing moves) operations that would
-        /// make a face intersect another one (`roar_ops::blocks::guard`), so the loop's mesh stays
-        /// intersection-free and every checkpoint is recent. [INF] Not in the paper. Off by default,
-        /// measured: it keeps folds the Face Collapse block would have removed, and the final
-        /// untangle clears what the unguarded blocks leave (gpytoolbox-airplane at 1000 faces:
-        /// Chamfer/diag 3.49e-3 with it, 2.13e-3 without; luke-f-16 1.92e-3 / 1.88e-3). Worth it
-        /// where the untangle fails and the run would finish from an old checkpoint (a 256-voxel
-        /// init of manifoldplus-chair: the collapse, split and smoothing blocks created crossings in
-        /// 88, 19 and 28 of their calls, and the run fell back to its init).
+        /// Let the blocks skip (collapses, flips) or shorten (smoothing moves) operations that
+        /// would make a face intersect another one (`roar_ops::blocks::guard`), so the loop's
+        /// mesh stays intersection-free and every checkpoint is recent. Not in the paper. Off:
+        /// it keeps folds the Face Collapse block would have removed, and the final untangle
+        /// clears what the unguarded blocks leave; worth turning on where the untangle fails and
+        /// the run would finish from an old checkpoint (why: `docs/method.md`, defaults table).
         guard_intersections: bool = false;
-        /// The Face Split block of an SDF input projects its samples onto the field (§3.4 C, up to
-        /// 6 gradient evaluations per sample) rather than by the k-NN planar projection over the point
-        /// cloud. The spec's choice and on by default; with a neural field it is most of the run's
-        /// evaluations (`docs/sdf.md`, "Measured cost").
+        /// The Face Split block of an SDF input projects its samples onto the field, as the paper
+        /// does, rather than by the k-NN planar projection over the point cloud (false). With a
+        /// neural field it is most of the run's evaluations (`docs/sdf.md`).
         sdf_split_projector: bool = true;
     }
 }
 
 config_table! {
-    /// `[finish]`
+    /// `[finish]`: from the loop's mesh to exactly `faces` faces.
     pub struct FinishConfig("finish") {
         /// Separation margin of the untangle block, relative to the bounding-box diagonal.
         untangle_margin: f64 = UntangleOptions::default().margin_rel, range(0.0, 0.01);
-        /// Before the final QEM, move every vertex this far (relative to the bounding-box diagonal)
-        /// outward along its normal, as far as no intersection appears (default 5e-4; 0 = off; only
-        /// when the polish runs, which moves the vertices back onto the target). [INF] Not in the
-        /// paper: the loop pulls the two sides of a thin part or of an open surface onto one sheet,
-        /// where the QEM's self-intersection veto refuses nearly every collapse and the decimation eats
-        /// the part from its rim instead (libigl-camelhead, an open surface, decimated from its
-        /// 5000-face loop mesh to 1000: 5.9 % of the input farther than 1 % of the diagonal from the
-        /// output, 0.3 % with an offset of 5e-4).
+        /// Before the final QEM, move every vertex this far (relative to the bounding-box
+        /// diagonal) outward along its normal, as far as no intersection appears (0 = off; only
+        /// when the polish runs, which moves the vertices back onto the target). The loop pulls
+        /// the two sides of a thin part or of an open surface onto one sheet, where the QEM's
+        /// self-intersection veto refuses nearly every collapse and the decimation eats the part
+        /// from its rim instead. Not in the paper (why: `docs/method.md`, defaults table).
         final_qem_offset: f64 = 5e-4, range(0.0, 0.1);
-        /// Sweeps of tangential smoothing at exactly N after the final QEM, before the polish (default
-        /// 3; 0 = none), each moved vertex put back on its old faces (§3.9 plus projection) and every
-        /// move limited so that no intersection appears. [INF] Not in the paper: with the sweeps off in
-        /// the loop, this is what keeps the output's triangles well shaped. Without it the outputs are
-        /// slightly closer to the input (Chamfer/diag 0.5–1 % lower on gpytoolbox-split_mountain and
-        /// libigl-camelhead at 5000 faces) but worse shaped (median aspect ratio over the 14 wild
-        /// meshes 1.46 with the init at 256 voxels, against 1.26 with the sweeps at 192;
-        /// `docs/method.md`).
+        /// Sweeps of tangential smoothing at exactly N after the final QEM, before the polish
+        /// (0 = none), each moved vertex put back on its old faces and every move limited so
+        /// that no intersection appears. With the sweeps off in the loop, this is what keeps the
+        /// output's triangles well shaped. Not in the paper (why: `docs/method.md`, defaults
+        /// table).
         final_smoothing_sweeps: usize = 3, range(0.0, 1e3);
-        /// Rounds of data-dependent edge flips at exactly N after the smoothing, before the polish
-        /// (default 5; 0 = off): an edge flips when the quad's other diagonal follows the point cloud's
-        /// normals better (`roar_ops::finish::data_flips`), no face gets worse than `Q = 4` (or the
-        /// worse old face) and no intersection appears. [INF] Not in the paper: the valence flips, the
-        /// smoothing and the final QEM choose the diagonals for the triangles' shapes and the working
-        /// mesh's quadrics, not for the target's normals (`docs/method.md`).
+        /// Rounds of data-dependent edge flips at exactly N after the smoothing, before the
+        /// polish (0 = off): an edge flips when the quad's other diagonal follows the point
+        /// cloud's normals better (`roar_ops::finish::data_flips`), no face gets worse than
+        /// `Q = 4` (or the worse old face) and no intersection appears. The valence flips, the
+        /// smoothing and the final QEM choose the diagonals for the triangles' shapes, not for
+        /// the target's normals. Not in the paper (why: `docs/method.md`, defaults table).
         data_flip_rounds: usize = DataFlipOptions::default().max_rounds, range(0.0, 1e3);
-        /// Move Vertices iterations at exactly N after the final QEM (default 20; 0 = off), with the
-        /// step limiter, a learning rate falling linearly to 0 and no blocks, so the face count and
-        /// topology stay; the state with the lowest loss is kept. [INF] Not in the paper: the final QEM
-        /// places vertices at quadric minimisers of the working-budget surface, not on the target. If
-        /// the kept mesh intersects itself, the QEM output is kept (the report says so). Runs only when
-        /// `iterations > 0`, so `--iterations 0` stays the plain init + QEM.
+        /// Move Vertices iterations at exactly N after the final QEM (0 = off), with the step
+        /// limiter, a learning rate falling linearly to 0 and no blocks, so the face count and
+        /// topology stay; the state with the lowest loss is kept. If the kept mesh intersects
+        /// itself, the QEM output is kept (the report says so). Runs only when `iterations > 0`,
+        /// so `--iterations 0` stays the plain init + QEM. Not in the paper, whose final QEM
+        /// leaves the vertices at quadric minimisers of the working-budget surface, off the
+        /// target (why: `docs/method.md`, defaults table).
         polish_iterations: usize = 20, range(0.0, 1e5);
-        /// For an input with a signed distance (an SDF), after the polish: this many steps (default
-        /// 3; 0 = off) that move every vertex along its normal by minus the mean first-order distance
-        /// `f/|∇f|` over its faces (sampled at their edge midpoints), except where the move is long
-        /// against its faces, would turn a face over or make faces intersect
-        /// (`roar_ops::finish::zero_set`). [INF] Not in the paper: the loop's mesh is on
-        /// the surface only as far as the losses pull it, and the fill splits to a large budget put
-        /// their vertices on chords (`docs/sdf.md`, "Measured cost"). Soups have no field and skip
-        /// it. Runs only when `iterations > 0`.
+        /// For an input with a signed distance (an SDF), after the polish: this many steps
+        /// (0 = off) that move every vertex along its normal by minus the mean first-order
+        /// distance `f/|∇f|` over its faces (sampled at their edge midpoints), except where the
+        /// move is long against its faces, would turn a face over or make faces intersect
+        /// (`roar_ops::finish::zero_set`). The loop's mesh is on the surface only as far as the
+        /// losses pull it. Soups have no field and skip it; runs only when `iterations > 0`. Not
+        /// in the paper (why: `docs/method.md`, defaults table).
         zero_set_steps: usize = ZeroSetOptions::default().steps, range(0.0, 100.0);
         /// For an SDF input, before the fit to the zero set: a vertex whose first-order distance
-        /// `|f|/|∇f|` from the zero set exceeds this times its mean edge length is collapsed into a
-        /// neighbour (the nearest to the zero set first) where no face turns over and no
+        /// `|f|/|∇f|` from the zero set exceeds this times its mean edge length is collapsed
+        /// into a neighbour (the nearest to the zero set first) where no face turns over and no
         /// intersection appears, and the face count is restored by edge splits
-        /// (`roar_ops::finish::fins`; default 0.5; 0 = off). [INF] Not in the paper: the untangle
-        /// can leave fins, flaps of faces standing off the surface that the fit would fold onto
-        /// themselves and so holds (`docs/sdf.md`). Runs only when `iterations > 0`.
-        fin_distance_over_edge: f64 = FinOptions::default().max_distance_over_edge, zero_or(0.01, 100.0);
-        /// Last step: flip the edges of faces with aspect ratio `Q = R/(2r)` above this when both faces
-        /// of the edge get better, the two are nearly coplanar (0.95; against the other face alone when
-        /// one is degenerate, above 100) and no intersection appears (`roar_ops::finish::slivers`;
-        /// default 10; 0 = off); then degenerate faces (above 100) that no flip fixes are removed by
-        /// collapsing one of their edges, and the face count is restored by edge splits that make no
-        /// degenerate face (`roar_ops::finish::degenerate`). [INF] Not in the paper: the optimization
-        /// and the polish move vertices for the losses, and the final QEM bounds only the faces it
-        /// creates, so a few caps (one angle near 180°) reach the output. Runs only when `iterations >
-        /// 0`.
+        /// (`roar_ops::finish::fins`; 0 = off). The untangle can leave fins, flaps of faces
+        /// standing off the surface that the fit would fold onto themselves. Runs only when
+        /// `iterations > 0`. Not in the paper.
+        fin_distance_over_edge: f64 = FinOptions::default().max_distance_over_edge,
+            zero_or(0.01, 100.0);
+        /// Last step: flip the edges of faces with aspect ratio `Q = R/(2r)` above this when
+        /// both faces of the edge get better, the two are nearly coplanar and no intersection
+        /// appears (`roar_ops::finish::slivers`; 0 = off); then degenerate faces that no flip
+        /// fixes are removed by collapsing one of their edges, and the face count is restored by
+        /// edge splits that make no degenerate face (`roar_ops::finish::degenerate`). The
+        /// optimization and the polish move vertices for the losses and the final QEM bounds
+        /// only the faces it creates, so a few caps would reach the output. Runs only when
+        /// `iterations > 0`. Not in the paper.
         sliver_quality: f64 = SliverOptions::default().max_quality, zero_or(1.0, 1e6);
-        /// Write the closest mesh when the final QEM cannot reach the budget, instead of failing.
+        /// Write the closest mesh when the final QEM cannot reach the budget, instead of
+        /// failing.
         best_effort: bool = false;
-        /// Keep the init's genus to the end: when the budget is too small for it (or the final QEM
-        /// stalls on the link condition) the run fails with the QEM's named error instead of
-        /// removing handles (`roar_ops::finish::genus`; DESIGN.md §2).
+        /// Keep the init's genus to the end: when the budget is too small for it (or the final
+        /// QEM stalls on the link condition) the run fails with the QEM's named error instead of
+        /// removing handles (`roar_ops::finish::genus`).
         keep_topology: bool = false;
     }
 }
 
 impl ReconstructConfig {
-    /// The SDF schedule of spec §5, the defaults for signed distance inputs: the full pipeline
+    /// The paper's SDF schedule, the defaults for signed distance inputs: the full pipeline
     /// with 700 iterations and 50k faces, the SDF loss on from iteration 500, every iteration
     /// on the full rig and run (no stop when the loss levels off before the SDF loss starts).
     pub fn sdf_defaults() -> Self {
@@ -502,7 +487,7 @@ impl ReconstructConfig {
         self.loss.planar_t2s_max_points = 0;
     }
 
-    /// W = clamp(factor·N, min, max), never below N (DESIGN.md §2).
+    /// W = clamp(factor·N, min, max), never below N, rounded up to even.
     pub fn working_budget(&self) -> usize {
         let w = (self.optimize.working_budget_factor * self.faces)
             .max(self.optimize.working_budget_min)
@@ -553,7 +538,7 @@ impl ReconstructConfig {
     }
 
     /// Every numeric field with its allowed range and its current value, named as the messages
-    /// name it (`loss.render_weight`).
+    /// name it (`loss.render_weight`): `faces` and `seed`, then each table's fields in order.
     /// The ranges are wide: they refuse what cannot mean anything (NaN, infinities, negative
     /// weights, zero samples, huge values that would exhaust memory or time), not what is merely
     /// unusual. `0 (off)` marks the fields where 0 switches a feature off, as their docs say.
@@ -745,10 +730,12 @@ mod tests {
         assert_eq!(sphere.init.kind, InitKind::Sphere);
     }
 
-    /// The defaults the field docs (and `docs/method.md`) state, so the two cannot drift apart.
+    /// The defaults `docs/method.md`'s defaults table (and the field docs) state, so they cannot
+    /// drift apart, and the library defaults the field docs say the pipeline departs from.
     #[test]
     fn documented_defaults() {
         let c = ReconstructConfig::default();
+        assert_eq!(c.faces, 5000);
         assert_eq!(c.seed, 43);
         assert_eq!(c.optimize.iterations, 200);
         assert_eq!(c.init.kind, InitKind::Watertight);
@@ -845,5 +832,33 @@ mod tests {
         assert_eq!(c.finish.polish_iterations, 20);
         assert_eq!(c.finish.sliver_quality, 10.0);
         assert_eq!(c.finish.fin_distance_over_edge, 0.5);
+        assert_eq!(c.finish.untangle_margin, 1e-6);
+        assert_eq!(
+            (c.finish.zero_set_steps, c.loss.sdf_loss_epsilon),
+            (3, 1e-10)
+        );
+        assert_eq!((c.loss.sdf_loss_weight, c.loss.sdf_loss_start), (0.1, 500));
+        assert_eq!(c.init.sdf_init_resolution, 64);
+        assert_eq!(
+            (c.target.winding_threshold, c.target.scan_max_edge_factor),
+            (0.2, 4.0)
+        );
+        assert_eq!(
+            (
+                c.target.sdf_trace_grid,
+                c.target.sdf_trace_refine_steps,
+                c.target.sdf_projection_steps,
+                c.target.sdf_projection_tolerance
+            ),
+            (128, 8, 5, 1e-5)
+        );
+
+        // The knobs whose pipeline default departs from the library's, as their docs say.
+        assert_eq!(roar_loss::planar::RECONSTRUCTION_PLANAR_SCALE, 500.0);
+        assert_eq!(PlanarOptions::default().scale, 5.0);
+        assert_eq!(TargetOptions::default().views_per_axis, 6);
+        assert_eq!(roar_ops::init::InitOptions::default().resolution, 128);
+        assert_eq!(PointCloudOptions::default().sheet_offset, 0.0);
+        assert_eq!(FaceCollapseOptions::default().min_normal_size, None);
     }
 }
