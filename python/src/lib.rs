@@ -74,12 +74,15 @@ fn roar_error(e: impl std::fmt::Display) -> PyErr {
     RoarError::new_err(e.to_string())
 }
 
+/// A configuration the Python half sent that roar refuses, with the CLI's message.
+fn config_error(e: impl std::fmt::Display) -> PyErr {
+    PyValueError::new_err(format!("config: {e}"))
+}
+
 /// The effective config: defaults, then the JSON of the user's dict (the CLI's TOML layout),
 /// then the face budget; validated like the CLI's.
 fn effective_config(config_json: &str, faces: usize) -> PyResult<ReconstructConfig> {
-    let config_error = |e: String| PyValueError::new_err(format!("config: {e}"));
-    let table: toml::Table =
-        serde_json::from_str(config_json).map_err(|e| config_error(e.to_string()))?;
+    let table: toml::Table = serde_json::from_str(config_json).map_err(config_error)?;
     let mut config = ReconstructConfig::from_table(table, &ReconstructConfig::default())
         .map_err(config_error)?;
     config.faces = faces;

@@ -19,10 +19,12 @@ use roar_ops::finish::zero_set::ZeroSetOptions;
 use roar_ops::init::{
     ENCLOSURE_MAX_CAP_FRACTION, ENCLOSURE_WINDING_THRESHOLD, InitialMeshOptions, SdfInitOptions,
 };
-use roar_ops::optim::OptimizerOptions;
+use roar_ops::optim::{OptimError, OptimizerOptions};
 use roar_ops::untangle::UntangleOptions;
 use roar_sdf::{SdfProjectorOptions, TraceOptions};
 use serde::{Deserialize, Serialize};
+
+use crate::budget::BudgetError;
 
 /// Declares one table of the configuration, each field once: its doc, name, type, default and,
 /// for a numeric field, its allowed range (`range(min, max)`: `min ..= max`; `zero_or(min, max)`:
@@ -499,23 +501,23 @@ impl ReconstructConfig {
     /// Checks every numeric field against its range ([`ReconstructConfig::field_ranges`]) and
     /// the rules between fields, before any work; the one-line error names the field, its value
     /// and what is allowed. NaN and infinities are outside every range.
-    pub fn validate(&self) -> Result<(), String> {
-        crate::budget::check_budget("faces =", self.faces, 4).map_err(|e| e.to_string())?;
+    pub fn validate(&self) -> Result<(), ConfigError> {
+        crate::budget::check_budget("faces =", self.faces, 4)?;
         for (range, value) in self.field_ranges() {
             if !range.allows(value) {
-                return Err(format!(
-                    "{} = {} is out of range: allowed {}",
-                    range.name,
+                return Err(ConfigError::OutOfRange {
+                    name: range.name,
                     value,
-                    range.describe()
-                ));
+                    allowed: range,
+                });
             }
         }
-        if self.optimize.working_budget_min > self.optimize.working_budget_max {
-            return Err(format!(
-                "optimize.working_budget_min = {} is above optimize.working_budget_max = {}",
-                self.optimize.working_budget_min, self.optimize.working_budget_max
-            ));
+        let optimize = &self.optimize;
+        if optimize.working_budget_min > optimize.working_budget_max {
+            return Err(ConfigError::WorkingBudgetBounds {
+                min: optimize.working_budget_min,
+                max: optimize.working_budget_max,
+            });
         }
         Ok(())
     }
@@ -523,16 +525,16 @@ impl ReconstructConfig {
     /// The config of a TOML file: `defaults` with the file's keys over them, table by table.
     /// Errors are one line: a key of another table (or a flat key of the ungrouped layout) names
     /// the table it belongs in, a bad value its line. Does not [`validate`](Self::validate).
-    pub fn from_toml(text: &str, defaults: &Self) -> Result<Self, String> {
-        let file: toml::Table = toml::from_str(text).map_err(one_line)?;
+    pub fn from_toml(text: &str, defaults: &Self) -> Result<Self, ConfigError> {
+        let file: toml::Table = toml::from_str(text)?;
         check_layout(&file)?;
         // Parsed alone, so a bad value is named with its line in the file.
-        toml::from_str::<Self>(text).map_err(one_line)?;
+        toml::from_str::<Self>(text)?;
         merge_over(file, defaults)
     }
 
     /// Like [`from_toml`](Self::from_toml) for a table already parsed (the Python package's dict).
-    pub fn from_table(file: toml::Table, defaults: &Self) -> Result<Self, String> {
+    pub fn from_table(file: toml::Table, defaults: &Self) -> Result<Self, ConfigError> {
         check_layout(&file)?;
         merge_over(file, defaults)
     }
@@ -559,8 +561,86 @@ impl ReconstructConfig {
     }
 }
 
+/// Why a configuration was refused. Every message is one line, naming the key to fix (the CLI
+/// and the Python package print it after `config: `, or after the file's path for a TOML error).
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum ConfigError {
+    /// A numeric field is outside its range (NaN and infinities are outside every range).
+    #[error("{name} = {value} is out of range: allowed {allowed}")]
+    OutOfRange {
+        /// The field's dotted name (`loss.render_weight`).
+        name: &'static str,
+        /// The refused value.
+        value: f64,
+        /// The values the field may take.
+        allowed: FieldRange,
+    },
+    /// `optimize.working_budget_min` is above `optimize.working_budget_max`.
+    #[error("optimize.working_budget_min = {min} is above optimize.working_budget_max = {max}")]
+    WorkingBudgetBounds {
+        /// `optimize.working_budget_min`.
+        min: usize,
+        /// `optimize.working_budget_max`.
+        max: usize,
+    },
+    /// `faces` is odd or below a tetrahedron's 4.
+    #[error(transparent)]
+    Budget(#[from] BudgetError),
+    /// `faces` is below what the init's pieces need (known only once the init is made).
+    #[error("{0} (for the pieces of the init)")]
+    BudgetForInit(BudgetError),
+    /// A key outside the table it belongs in: a flat key of the ungrouped layout, or a key under
+    /// another table.
+    #[error(
+        "`{key}` {}: it belongs in the [{table}] table (write it under [{table}])",
+        not_a_key_of(.found_in)
+    )]
+    MisplacedKey {
+        /// The key.
+        key: String,
+        /// The table it was found in (`None`: at the top level).
+        found_in: Option<String>,
+        /// The table it belongs in.
+        table: String,
+    },
+    /// `init` (the ungrouped layout's initial mesh kind), which is now `kind` in `[init]`.
+    #[error(
+        "`init` {}: the initial mesh's kind is `kind` in the [init] table",
+        not_a_key_of(.found_in)
+    )]
+    InitKey {
+        /// The table it was found in (`None`: at the top level).
+        found_in: Option<String>,
+    },
+    /// The text is not TOML, or a key is unknown or has a value of the wrong type; the message
+    /// is the parser's, on one line, with the line of the file it refers to.
+    #[error("{}", one_line(.0))]
+    Toml(toml::de::Error),
+    /// The defaults could not be written as a TOML table to merge a file over (a bug).
+    #[error(transparent)]
+    Layout(#[from] toml::ser::Error),
+    /// The optimizer refused the learning rate or the Laplacian weight.
+    #[error(transparent)]
+    Optimizer(#[from] OptimError),
+}
+
+// Not `#[from]`: the TOML error is the message itself, not a cause to print after it.
+impl From<toml::de::Error> for ConfigError {
+    fn from(error: toml::de::Error) -> Self {
+        ConfigError::Toml(error)
+    }
+}
+
+/// Where a misplaced key was found, for [`ConfigError`]'s messages.
+fn not_a_key_of(table: &Option<String>) -> String {
+    match table {
+        Some(table) => format!("is not a key of [{table}]"),
+        None => "is not a top-level key".to_string(),
+    }
+}
+
 /// A TOML error on one line, for the CLI's one-line messages.
-fn one_line(e: toml::de::Error) -> String {
+fn one_line(e: &toml::de::Error) -> String {
     e.to_string().replace('\n', " ").trim().to_string()
 }
 
@@ -569,8 +649,8 @@ fn one_line(e: toml::de::Error) -> String {
 fn merge_over(
     file: toml::Table,
     defaults: &ReconstructConfig,
-) -> Result<ReconstructConfig, String> {
-    let mut merged = toml::Table::try_from(defaults).map_err(|e| e.to_string())?;
+) -> Result<ReconstructConfig, ConfigError> {
+    let mut merged = toml::Table::try_from(defaults)?;
     for (key, value) in file {
         match (merged.get_mut(&key), value) {
             (Some(toml::Value::Table(table)), toml::Value::Table(keys)) => table.extend(keys),
@@ -579,29 +659,32 @@ fn merge_over(
             }
         }
     }
-    merged.try_into().map_err(one_line)
+    Ok(merged.try_into()?)
 }
 
 /// Refuses a key outside the table it belongs in, naming that table: the flat keys of the
 /// ungrouped layout (`render_weight = 3` at the top) and keys under the wrong table.
-fn check_layout(file: &toml::Table) -> Result<(), String> {
-    let layout = toml::Table::try_from(ReconstructConfig::default()).map_err(|e| e.to_string())?;
+fn check_layout(file: &toml::Table) -> Result<(), ConfigError> {
+    let layout = toml::Table::try_from(ReconstructConfig::default())?;
     let home = |key: &str| {
         layout.iter().find_map(|(table, value)| match value {
-            toml::Value::Table(leaves) if leaves.contains_key(key) => Some(table.as_str()),
+            toml::Value::Table(leaves) if leaves.contains_key(key) => Some(table.clone()),
             _ => None,
         })
     };
-    let misplaced = |key: &str, here: &str| -> Result<(), String> {
+    // A key found in `found_in` (`None`: the top level) where it is not a key: refused if it
+    // belongs in another table; an unknown key is left to the parser.
+    let misplaced = |key: &str, found_in: Option<&String>| -> Result<(), ConfigError> {
+        let found_in = found_in.cloned();
         if key == "init" {
-            return Err(format!(
-                "`init` {here}: the initial mesh's kind is `kind` in the [init] table"
-            ));
+            return Err(ConfigError::InitKey { found_in });
         }
         match home(key) {
-            Some(table) => Err(format!(
-                "`{key}` {here}: it belongs in the [{table}] table (write it under [{table}])"
-            )),
+            Some(table) => Err(ConfigError::MisplacedKey {
+                key: key.to_string(),
+                found_in,
+                table,
+            }),
             None => Ok(()),
         }
     };
@@ -610,12 +693,12 @@ fn check_layout(file: &toml::Table) -> Result<(), String> {
             (Some(toml::Value::Table(_)), toml::Value::Table(keys)) => {
                 for leaf in keys.keys() {
                     if !layout[key].as_table().is_some_and(|t| t.contains_key(leaf)) {
-                        misplaced(leaf, &format!("is not a key of [{key}]"))?;
+                        misplaced(leaf, Some(key))?;
                     }
                 }
             }
             (Some(toml::Value::Table(_)), _) | (None, _) => {
-                misplaced(key, "is not a top-level key")?;
+                misplaced(key, None)?;
             }
             _ => {}
         }
@@ -661,14 +744,18 @@ impl FieldRange {
         (self.zero_is_off && value == 0.0) || (value >= self.min && value <= self.max)
     }
 
-    /// The range in words, for messages: `0 (off) or 1 to 1000000`.
+    /// The range in words, for messages: `0 (off) or 1 to 1000000` (its `Display`).
     pub fn describe(&self) -> String {
-        let span = format!("{} to {}", self.min, self.max);
+        self.to_string()
+    }
+}
+
+impl std::fmt::Display for FieldRange {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         if self.zero_is_off {
-            format!("0 (off) or {span}")
-        } else {
-            span
+            write!(f, "0 (off) or ")?;
         }
+        write!(f, "{} to {}", self.min, self.max)
     }
 }
 
@@ -709,7 +796,20 @@ mod tests {
     #[test]
     fn misplaced_keys_name_their_table() {
         let d = ReconstructConfig::default();
-        let refused = |text: &str| ReconstructConfig::from_toml(text, &d).unwrap_err();
+        let refused = |text: &str| {
+            ReconstructConfig::from_toml(text, &d)
+                .unwrap_err()
+                .to_string()
+        };
+        let typed = ReconstructConfig::from_toml("render_weight = 2.0\n", &d).unwrap_err();
+        assert_eq!(
+            typed,
+            ConfigError::MisplacedKey {
+                key: "render_weight".to_string(),
+                found_in: None,
+                table: "loss".to_string(),
+            }
+        );
         let e = refused("render_weight = 2.0\n");
         assert!(e.contains("`render_weight`") && e.contains("[loss]"), "{e}");
         let e = refused("[loss]\niterations = 3\n");

@@ -6,14 +6,15 @@ use roar_ops::finish::exact_budget::ExactBudgetError;
 use roar_ops::finish::genus::ReduceGenusError;
 use roar_ops::init::InitError;
 
+use crate::config::ConfigError;
 use crate::shape::ShapeError;
 
 /// Why a reconstruction failed.
 #[derive(Debug, thiserror::Error)]
 pub enum PipelineError {
-    /// The configuration is unusable.
+    /// The configuration is unusable, or its face budget too small for the init's pieces.
     #[error("config: {0}")]
-    Config(String),
+    Config(#[from] ConfigError),
     /// Target preparation or a loss failed.
     #[error("{0}")]
     Loss(#[from] LossError),

@@ -12,7 +12,7 @@ use roar_ops::optim::{Optimizer, OptimizerOptions};
 use roar_ops::untangle::{LimiterOptions, limit_steps};
 use roar_render::{Camera, Image};
 
-use crate::config::ReconstructConfig;
+use crate::config::{ConfigError, ReconstructConfig};
 use crate::error::PipelineError;
 use crate::objective::{LossFactory, Prepared};
 use crate::report::{IterationRecord, RunStats};
@@ -225,7 +225,7 @@ pub(crate) fn new_optimizer(
             ..OptimizerOptions::default()
         },
     )
-    .map_err(|e| PipelineError::Config(e.to_string()))
+    .map_err(|e| ConfigError::Optimizer(e).into())
 }
 
 /// One Move Vertices step (spec §3.2.4): the loss and its gradient on the compacted mesh, the
