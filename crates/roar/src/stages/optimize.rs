@@ -252,9 +252,7 @@ pub(crate) fn move_vertices(
         .optimize
         .step_limiter
         .then(|| mesh.positions().to_vec());
-    optimizer
-        .step(mesh.positions_mut(), &triangles, &gradient)
-        .map_err(|e| PipelineError::Internal(e.to_string()))?;
+    optimizer.step(mesh.positions_mut(), &triangles, &gradient)?;
     clock.lap(&format!("{stage}_step"));
     if let Some(before) = before {
         let limited = limit_steps(
