@@ -17,7 +17,7 @@ use pyo3::exceptions::{PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyBytes, PyDict};
 use roar::{PipelineError, Progress, ReconstructConfig, Reconstruction, SoupShape};
-use roar_eval::EvalOptions;
+use roar_eval::{EvalError, EvalOptions};
 use roar_io::TriangleSoup;
 use roar_mesh::Mesh;
 
@@ -74,12 +74,15 @@ fn roar_error(e: impl std::fmt::Display) -> PyErr {
     RoarError::new_err(e.to_string())
 }
 
+/// A configuration the Python half sent that roar refuses, with the CLI's message.
+fn config_error(e: impl std::fmt::Display) -> PyErr {
+    PyValueError::new_err(format!("config: {e}"))
+}
+
 /// The effective config: defaults, then the JSON of the user's dict (the CLI's TOML layout),
 /// then the face budget; validated like the CLI's.
 fn effective_config(config_json: &str, faces: usize) -> PyResult<ReconstructConfig> {
-    let config_error = |e: String| PyValueError::new_err(format!("config: {e}"));
-    let table: toml::Table =
-        serde_json::from_str(config_json).map_err(|e| config_error(e.to_string()))?;
+    let table: toml::Table = serde_json::from_str(config_json).map_err(config_error)?;
     let mut config = ReconstructConfig::from_table(table, &ReconstructConfig::default())
         .map_err(config_error)?;
     config.faces = faces;
@@ -126,6 +129,35 @@ fn write_mesh(py: Python<'_>, path: PathBuf, positions: &[u8], triangles: &[u8])
         .map_err(roar_error)
 }
 
+/// Why a run of [`run_reconstruction`] failed: the pipeline, or the metrics of its input or output
+/// (a bug: both are valid soups by then).
+#[derive(Debug)]
+enum RunError {
+    Pipeline(PipelineError),
+    Eval(EvalError),
+}
+
+impl From<PipelineError> for RunError {
+    fn from(e: PipelineError) -> Self {
+        RunError::Pipeline(e)
+    }
+}
+
+impl From<EvalError> for RunError {
+    fn from(e: EvalError) -> Self {
+        RunError::Eval(e)
+    }
+}
+
+impl std::fmt::Display for RunError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            RunError::Pipeline(e) => e.fmt(f),
+            RunError::Eval(e) => write!(f, "internal: {e}"),
+        }
+    }
+}
+
 fn run_reconstruction<'py>(
     py: Python<'py>,
     soup: &TriangleSoup,
@@ -169,16 +201,14 @@ fn run_reconstruction<'py>(
             ..EvalOptions::default()
         };
         let input_metrics =
-            roar_eval::evaluate(&soup.positions, &soup.triangles, None, &eval_input)
-                .map_err(|e| PipelineError::Internal(e.to_string()))?;
+            roar_eval::evaluate(&soup.positions, &soup.triangles, None, &eval_input)?;
         let output_metrics = roar_eval::evaluate(
             &result.positions,
             &result.triangles,
             Some((&soup.positions, &soup.triangles)),
             &EvalOptions::default(),
-        )
-        .map_err(|e| PipelineError::Internal(e.to_string()))?;
-        Ok::<_, PipelineError>((result, input_metrics, output_metrics))
+        )?;
+        Ok::<_, RunError>((result, input_metrics, output_metrics))
     });
     if let Some(e) = stopped_by {
         return Err(e);

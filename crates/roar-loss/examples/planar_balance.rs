@@ -78,7 +78,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 p.1,
                 p.2,
                 r.1 / p.1,
-                r.1 / (p.1 * roar_loss::planar::DEFAULT_PLANAR_SCALE)
+                r.1 / (p.1 * roar_loss::planar::SPHERE_BALANCED_PLANAR_SCALE)
             );
         }
     }

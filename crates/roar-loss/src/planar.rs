@@ -29,8 +29,9 @@ use crate::point_tree::{PointTree, SearchStack};
 /// Target points per parallel work item of the t2s assignment.
 const CHUNK: usize = 4096;
 
-/// Default of [`PlanarOptions::scale`]: with the raw loss the planar gradient is far below the
-/// render gradient and would do almost nothing
+/// The library's default of [`PlanarOptions::scale`], balanced on a sphere at weight 1: not the
+/// scale `roar reconstruct` uses, which is [`RECONSTRUCTION_PLANAR_SCALE`]. With the raw loss the
+/// planar gradient is far below the render gradient and would do almost nothing
 /// (`docs/method.md#decision-balance-of-the-planar-term`). Measured by
 /// `examples/planar_balance.rs` (36 views at 256², L1 render loss, icosphere source of radius 0.5
 /// against a sphere of radius R, P = 200k exact samples): mean per-vertex gradient norm of the
@@ -38,10 +39,19 @@ const CHUNK: usize = 4096;
 /// (icospheres of 320, 1280 and 5120 faces; the ratio does not drift with resolution because both
 /// scale like 1/#V). A factor 5 brings the terms to 3–4× (gap 0.01) and 0.6–0.8× (gap 0.05) at
 /// weight 1, i.e. within 10× over the working range; the planar term still fades as the gap
-/// closes (it is quadratic), the render term does not. `roar reconstruct` passes its own
-/// `planar_scale` (500): on the init of a wild mesh the raw planar gradient is far smaller
-/// against the render gradient than on this sphere (same section).
-pub const DEFAULT_PLANAR_SCALE: f64 = 5.0;
+/// closes (it is quadratic), the render term does not.
+#[doc(alias = "DEFAULT_PLANAR_SCALE")]
+pub const SPHERE_BALANCED_PLANAR_SCALE: f64 = 5.0;
+
+/// The scale of the planar term in `roar reconstruct` (the default of its `[loss] planar_scale`),
+/// balanced against the render term (weight 3) on the inits of real inputs, where the raw planar
+/// gradient is far smaller against the render gradient than on the sphere
+/// [`SPHERE_BALANCED_PLANAR_SCALE`] is balanced on. Measured with
+/// `crates/roar/examples/loss_balance.rs` on wild meshes' inits at 5000 faces (mean per-vertex
+/// gradient): 3·render ≈ 3.1e-3, raw planar ≈ 1.3e-6–3.1e-6, Laplacian ≈ 3e-4–6e-4; at 500 the
+/// planar term (6e-4–1.5e-3) is within 5× of the render term instead of 500× below it
+/// (`docs/method.md`). [`PlanarOptions::default`] does not use it.
+pub const RECONSTRUCTION_PLANAR_SCALE: f64 = 500.0;
 
 /// Default of [`PlanarOptions::max_samples`]: 12 500 source samples per evaluation (the paper's
 /// density gives 150–300k on a typical shape). Measured by `examples/planar_profile.rs`
@@ -82,8 +92,9 @@ pub struct PlanarOptions {
     /// face keeps a share `cap/total` of its samples (stratified, see [`stratified_subsample`]).
     pub max_samples: usize,
     /// Multiplies the raw loss `mean_i ‖d_i‖²` and its gradient.
-    /// 1 is the raw loss; the default [`DEFAULT_PLANAR_SCALE`] makes the planar gradient
-    /// comparable to the render gradient at weight 1. The raw and render gradients both scale
+    /// 1 is the raw loss; the default [`SPHERE_BALANCED_PLANAR_SCALE`] makes the planar
+    /// gradient comparable to the render gradient at weight 1 on a sphere (`roar reconstruct`
+    /// passes [`RECONSTRUCTION_PLANAR_SCALE`]). The raw and render gradients both scale
     /// like 1/#V per vertex, so a constant factor keeps the balance across resolutions.
     pub scale: f64,
     /// Seed of the ChaCha8 stream that drives sampling; advanced on every evaluation.
@@ -99,7 +110,7 @@ impl Default for PlanarOptions {
             t2s_max_points: DEFAULT_T2S_MAX_POINTS,
             sampling: RegularSamplingOptions::default(),
             max_samples: DEFAULT_MAX_SAMPLES,
-            scale: DEFAULT_PLANAR_SCALE,
+            scale: SPHERE_BALANCED_PLANAR_SCALE,
             seed: 0,
         }
     }
@@ -652,10 +663,11 @@ mod tests {
     /// The defaults the docs of [`PlanarOptions`], its constants and [`KnnOptions`] state.
     #[test]
     fn documented_defaults() {
-        assert_eq!(DEFAULT_PLANAR_SCALE, 5.0);
+        assert_eq!(SPHERE_BALANCED_PLANAR_SCALE, 5.0);
+        assert_eq!(RECONSTRUCTION_PLANAR_SCALE, 500.0);
         assert_eq!(DEFAULT_MAX_SAMPLES, 12_500);
         let o = PlanarOptions::default();
-        assert_eq!(o.scale, DEFAULT_PLANAR_SCALE);
+        assert_eq!(o.scale, SPHERE_BALANCED_PLANAR_SCALE);
         assert_eq!(o.max_samples, DEFAULT_MAX_SAMPLES);
         assert!(o.t2s);
         assert_eq!(o.t2s_normal_dot, 0.95);

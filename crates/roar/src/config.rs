@@ -1,49 +1,167 @@
-//! The reconstruction's configuration: every hyper-parameter of the spec with the paper's
-//! default, each documented with the section of `spec/roar-method.md` it comes from. A TOML
-//! file overrides any subset (unknown keys are errors); the CLI's flags override the file.
+//! The reconstruction's configuration: every knob of `roar reconstruct`, in the TOML tables
+//! `[target]`, `[init]`, `[loss]`, `[optimize]` and `[finish]`. A TOML file (or the Python
+//! package's dict) overrides any subset (unknown keys are errors); the CLI's flags override the
+//! file. Each field is declared once, with its doc, type, default and allowed range
+//! (`config_table!`); where a library's `Options::default()` holds the same knob, the default is
+//! read from there. Why each default: `docs/method.md`, defaults table.
 
+use roar_io::PatchOptions;
+use roar_loss::planar::{DEFAULT_MAX_SAMPLES, DEFAULT_T2S_MAX_POINTS, RECONSTRUCTION_PLANAR_SCALE};
+use roar_loss::{
+    KnnOptions, PlanarOptions, PointCloudOptions, SdfLossOptions, SharpEdgeOptions, TargetOptions,
+};
+use roar_ops::blocks::collapse::FaceCollapseOptions;
+use roar_ops::blocks::split::DEFAULT_SPLIT_THRESHOLD;
+use roar_ops::finish::data_flips::DataFlipOptions;
+use roar_ops::finish::fins::FinOptions;
+use roar_ops::finish::slivers::SliverOptions;
+use roar_ops::finish::zero_set::ZeroSetOptions;
+use roar_ops::init::{
+    ENCLOSURE_MAX_CAP_FRACTION, ENCLOSURE_WINDING_THRESHOLD, InitialMeshOptions, SdfInitOptions,
+};
+use roar_ops::optim::{OptimError, OptimizerOptions};
+use roar_ops::untangle::UntangleOptions;
+use roar_sdf::{SdfProjectorOptions, TraceOptions};
 use serde::{Deserialize, Serialize};
 
-/// The enclosure rule's threshold for scan sets (`enclosure_winding_threshold` of
-/// `ReconstructConfig::scan_defaults`), below the
-/// soups' `roar_ops::init::ENCLOSURE_WINDING_THRESHOLD` (0.7) because scans leave wider
-/// openings: four bunny scans around its side (bun000, bun090, bun180, bun270; top and base
-/// unscanned) give an init of genus 1 at 0.7 (a tunnel from top to base) and of genus 0 at 0.6
-/// and 0.5.
+use crate::budget::BudgetError;
+
+/// Declares one table of the configuration, each field once: its doc, name, type, default and,
+/// for a numeric field, its allowed range (`range(min, max)`: `min ..= max`; `zero_or(min, max)`:
+/// 0 as well, meaning "off"; booleans and enums have none). Derives the struct (every key
+/// optional, unknown keys refused, the fields in the order written, which is the TOML's), its
+/// `Default` and its `field_ranges`, the ranges named `table.field` as the messages name them.
+macro_rules! config_table {
+    (
+        $(#[$meta:meta])*
+        pub struct $name:ident($table:literal) {
+            $(
+                $(#[$field_meta:meta])*
+                $field:ident: $ty:ty = $default:expr $(, $kind:ident($min:expr, $max:expr))?;
+            )*
+        }
+    ) => {
+        $(#[$meta])*
+        #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+        #[serde(default, deny_unknown_fields)]
+        pub struct $name {
+            $(
+                $(#[$field_meta])*
+                #[doc = ""]
+                #[doc = concat!(
+                    "Default: `", stringify!($default), "`",
+                    $(
+                        "; allowed: `", stringify!($kind), "(", stringify!($min), ", ",
+                        stringify!($max), ")`",
+                    )?
+                    "."
+                )]
+                pub $field: $ty,
+            )*
+        }
+
+        impl Default for $name {
+            fn default() -> Self {
+                Self {
+                    $($field: $default,)*
+                }
+            }
+        }
+
+        impl $name {
+            /// Every numeric field of the table with its allowed range and its current value,
+            /// in declaration order.
+            pub fn field_ranges(&self) -> Vec<(FieldRange, f64)> {
+                vec![
+                    $($(
+                        (
+                            field_range!(
+                                $kind,
+                                concat!($table, ".", stringify!($field)),
+                                $min,
+                                $max
+                            ),
+                            RangeValue::range_value(self.$field),
+                        ),
+                    )?)*
+                ]
+            }
+        }
+    };
+}
+
+/// The [`FieldRange`] of a `range(min, max)` or `zero_or(min, max)` declaration.
+macro_rules! field_range {
+    (range, $name:expr, $min:expr, $max:expr) => {
+        FieldRange::new($name, $min, $max)
+    };
+    (zero_or, $name:expr, $min:expr, $max:expr) => {
+        FieldRange::zero_or($name, $min, $max)
+    };
+}
+
+/// A numeric field's value as its range compares it.
+trait RangeValue {
+    fn range_value(self) -> f64;
+}
+
+impl RangeValue for f64 {
+    fn range_value(self) -> f64 {
+        self
+    }
+}
+
+impl RangeValue for u32 {
+    fn range_value(self) -> f64 {
+        f64::from(self)
+    }
+}
+
+impl RangeValue for usize {
+    fn range_value(self) -> f64 {
+        self as f64
+    }
+}
+
+/// The enclosure rule's threshold for scan sets (`init.enclosure_winding_threshold` of
+/// [`ReconstructConfig::scan_defaults`]), below the soups'
+/// `roar_ops::init::ENCLOSURE_WINDING_THRESHOLD` (0.7): scans leave wider openings than soups'
+/// punctures, and at the soups' threshold the init can keep a tunnel through the parts the
+/// scanner never saw (why: `docs/scans.md`).
 pub const SCAN_ENCLOSURE_WINDING_THRESHOLD: f64 = 0.6;
 
-/// How the initial mesh M0 is made (spec §4).
+/// How the initial mesh M0 is made.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum InitKind {
     /// The input shape's own initial mesh (`Shape::initial_mesh`): for a soup the watertight
-    /// voxel init of the cleaned target, in the manner of Manifold (§4.1).
+    /// voxel init of the cleaned target, in the manner of Manifold.
     Watertight,
-    /// An icosphere of radius 0.5 (§4.2); its genus is 0, so holes of the input are lost.
+    /// An icosphere of radius 0.5; its genus is 0, so holes of the input are lost.
     Sphere,
 }
 
 /// Every knob of `roar reconstruct`, grouped by the pipeline stage that reads it: the TOML file
 /// has the tables `[target]`, `[init]`, `[loss]`, `[optimize]` and `[finish]` (`--print-config`
-/// prints them all). Where a field's doc names its default (or `docs/method.md` does), the unit
-/// test `documented_defaults` checks that the code agrees.
+/// prints them all). The unit test `documented_defaults` checks the defaults that
+/// `docs/method.md`'s defaults table states.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct ReconstructConfig {
-    /// Exact face count of the output (even). §1.1 "face budget B".
+    /// Exact face count of the output (even).
     pub faces: usize,
-    /// Seed of every random choice (§10: seed 43).
+    /// Seed of every random choice.
     pub seed: u64,
-    /// The target T′ (§3.1): the rig it is rendered with, its point cloud, and how scans and
-    /// signed distances are read into it.
+    /// The target T′: the rig it is rendered with, its point cloud, and how scans and signed
+    /// distances are read into it.
     pub target: TargetConfig,
-    /// The initial mesh M0 (§4).
+    /// The initial mesh M0.
     pub init: InitConfig,
-    /// The loss the loop minimises (§3.2).
+    /// The loss the loop minimises.
     pub loss: LossConfig,
-    /// The loop (§1.2): Move Vertices and its blocks, at the working budget.
+    /// The loop: Move Vertices and its remeshing blocks, at the working budget.
     pub optimize: OptimizeConfig,
-    /// From the loop's mesh to exactly N faces (§1.2 step 7 and the steps after it).
+    /// From the loop's mesh to exactly `faces` faces.
     pub finish: FinishConfig,
 }
 
@@ -61,391 +179,274 @@ impl Default for ReconstructConfig {
     }
 }
 
-/// `[target]`
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(default, deny_unknown_fields)]
-pub struct TargetConfig {
-    /// Views per axis of the star rig: n² views (§3.2.1: 6 → 36). Default 5 (25 views); 6 in
-    /// the SDF and scan schedules. [INF] Fewer views than the paper: each loop iteration
-    /// renders 31 % fewer pixels and the loop levels off sooner, for a Chamfer distance within
-    /// 0.2 % (median) of 36 views on the wild meshes (`docs/method.md`, "The rig has 25 views").
-    pub views_per_axis: usize,
-    /// Render resolution in pixels (§3.2.1: 512).
-    pub render_resolution: u32,
-    /// Keep both twins of a soup face unless one has this many times more pixels (§3.1 a: 80).
-    pub twin_ratio: f64,
-    /// Target point cloud samples (§3.1 b: 200k).
-    pub point_cloud_samples: usize,
-    /// Keep target samples whose winding number at p + 1e-3·n is below this (§3.1 b, OQ-14).
-    pub winding_threshold: f64,
-    /// Target samples on a sheet (a face of T′ whose reversed twin is kept too: an open surface
-    /// or a zero-thickness part) stand off it by this much along their normal, relative to the
-    /// bounding-box diagonal, so the two sides of the closed output each get their own plane
-    /// instead of jamming against each other on one (0 = off). [INF] Not in the paper; the
-    /// value is the offset CGAL's alpha wrap is run with in the evaluation (`roar_loss::
-    /// point_cloud` explains the jam; at 5000 faces the normal cosine rose on every sheet of the
-    /// evaluation, the Chamfer distance grew on closely fitted ones: `docs/method.md`, "Sheets get
-    /// one plane per side").
-    pub sheet_offset: f64,
-    /// Sharp-edge samples from the init (§3.1 c: 30k).
-    pub sharp_edge_samples: usize,
-    /// Range scans: a patch triangle with an edge longer than this many times the local grid
-    /// spacing bridges a depth jump and is dropped (`roar_io::PatchOptions::max_edge_factor`,
-    /// where the default is measured).
-    pub scan_max_edge_factor: f64,
-    /// Range scans: a patch triangle whose normal is more than this many degrees from the
-    /// direction to the scanner is dropped (`roar_io::PatchOptions::max_angle_degrees`).
-    pub scan_max_angle_degrees: f64,
-    /// Range scans: refine the `.conf` poses by ICP (`roar_ops::align`); `--no-icp` turns it off.
-    pub scan_icp: bool,
-    /// Cells of the grid that brackets the zero set for an SDF input's traced target renders
-    /// (`roar_sdf::trace`): features thinner than about one cell can be missed.
-    pub sdf_trace_grid: usize,
-    /// Regula falsi steps per traced pixel of an SDF input.
-    pub sdf_trace_refine_steps: usize,
-    /// First-order steps of an SDF input's projections: the Face Split projector (§3.4 C: 5)
-    /// and the point-cloud samples.
-    pub sdf_projection_steps: usize,
-    /// A projected sample of an SDF input is valid when its first-order distance `|f|/|∇f|` ends
-    /// at most this, in rig units (§3.4 C: 1e-6 for float64 fields; f32 networks need more).
-    pub sdf_projection_tolerance: f64,
-}
-
-impl Default for TargetConfig {
-    fn default() -> Self {
-        Self {
-            views_per_axis: 5,
-            render_resolution: 512,
-            twin_ratio: 80.0,
-            point_cloud_samples: 200_000,
-            winding_threshold: 0.2,
-            sheet_offset: 1e-3,
-            sharp_edge_samples: 30_000,
-            scan_max_edge_factor: 4.0,
-            scan_max_angle_degrees: 80.0,
-            scan_icp: true,
-            sdf_trace_grid: 128,
-            sdf_trace_refine_steps: 8,
-            sdf_projection_steps: 5,
-            sdf_projection_tolerance: 1e-5,
-        }
+config_table! {
+    /// `[target]`: the target T′ the loop fits, its renders and its point cloud.
+    pub struct TargetConfig("target") {
+        /// Views per axis of the star rig: n² views (6 in the SDF and scan schedules).
+        /// `roar_loss::TargetOptions` keeps the paper's 6 (36 views); the pipeline renders 25, so
+        /// each loop iteration renders fewer pixels (why: `docs/method.md`, defaults table).
+        views_per_axis: usize = 5, range(1.0, 32.0);
+        /// Render resolution in pixels of the target renders (and of the loop's views when they
+        /// are not coarse, see `loss.render_coarse_resolution`).
+        render_resolution: u32 = TargetOptions::default().resolution, range(16.0, 4096.0);
+        /// Keep both twins of a soup face unless one has this many times more pixels.
+        twin_ratio: f64 = TargetOptions::default().twin_ratio, range(1.0, 1e6);
+        /// Samples of the target point cloud.
+        point_cloud_samples: usize = PointCloudOptions::default().samples, range(100.0, 5e7);
+        /// Keep target samples whose winding number at p + 1e-3·n is below this.
+        winding_threshold: f64 = PointCloudOptions::default().winding_threshold, range(1e-6, 1.0);
+        /// Target samples on a sheet (a face of T′ whose reversed twin is kept too: an open
+        /// surface or a zero-thickness part) stand off it by this much along their normal,
+        /// relative to the bounding-box diagonal, so the two sides of the closed output each get
+        /// their own plane instead of jamming against each other on one (0 = off). Not in the
+        /// paper. The library's `PointCloudOptions::sheet_offset` is absolute and off; the
+        /// pipeline's is relative and on (why: `docs/method.md`, defaults table).
+        sheet_offset: f64 = 1e-3, range(0.0, 0.1);
+        /// Samples on the sharp edges of the init, added to the target point cloud (0 = none).
+        sharp_edge_samples: usize = SharpEdgeOptions::default().samples, range(0.0, 5e7);
+        /// Range scans: a patch triangle with an edge longer than this many times the local grid
+        /// spacing bridges a depth jump and is dropped.
+        scan_max_edge_factor: f64 = PatchOptions::default().max_edge_factor, range(1.0, 1e3);
+        /// Range scans: a patch triangle whose normal is more than this many degrees from the
+        /// direction to the scanner is dropped.
+        scan_max_angle_degrees: f64 = PatchOptions::default().max_angle_degrees, range(1.0, 90.0);
+        /// Range scans: refine the `.conf` poses by ICP (`roar_ops::align`); `--no-icp` turns it
+        /// off.
+        scan_icp: bool = true;
+        /// Cells of the grid that brackets the zero set for an SDF input's traced target renders
+        /// (`roar_sdf::trace`): features thinner than about one cell can be missed.
+        sdf_trace_grid: usize = TraceOptions::default().grid_resolution, range(2.0, 2048.0);
+        /// Regula falsi steps per traced pixel of an SDF input.
+        sdf_trace_refine_steps: usize = TraceOptions::default().refine_steps, range(0.0, 100.0);
+        /// First-order steps of an SDF input's projections: the Face Split projector and the
+        /// point-cloud samples.
+        sdf_projection_steps: usize = SdfProjectorOptions::default().steps, range(1.0, 100.0);
+        /// A projected sample of an SDF input is valid when its first-order distance `|f|/|∇f|`
+        /// ends at most this, in rig units. Looser than the paper's 1e-6, which float64 fields
+        /// reach but float32 networks do not.
+        sdf_projection_tolerance: f64 = SdfProjectorOptions::default().tolerance,
+            range(1e-12, 1.0);
     }
 }
 
-/// `[init]`
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(default, deny_unknown_fields)]
-pub struct InitConfig {
-    /// Initial mesh (§4).
-    pub kind: InitKind,
-    /// Voxels along the longest axis of the watertight init (replaces Manifold's octree
-    /// resolution, OQ-12). The init closes gaps of one voxel and the loop never changes the
-    /// genus, so this decides which slots and holes of the input survive: 192 keeps gaps down to
-    /// about diag/170 on a box-like shape, on a par with alpha wrapping at α = diag/300, where
-    /// `roar init`'s 128 fills the slots between a chair's slats. 256 opens narrower cavities
-    /// (libigl-camelhead's ears) and costs 3–5 s more on the wild meshes, but gains less than it
-    /// gives roar's own init + QEM (`docs/method.md`).
-    pub init_resolution: usize,
-    /// The init is decimated to at most this many faces (§4.1: 20k).
-    pub init_max_faces: usize,
-    /// Enclosure rule of the watertight init (`roar_ops::init::winding_solid`; 0 = off):
-    /// exterior voxels whose generalized winding number with respect to T′ is above this value
-    /// turn solid, so punctures of a closed surface close while tunnels stay. Default
-    /// `roar_ops::init::ENCLOSURE_WINDING_THRESHOLD` (0.7).
-    pub enclosure_winding_threshold: f64,
-    /// A region the enclosure rule fills stays filled only if its widest cap (a patch of its
-    /// boundary no input surface covers) is at most this fraction of its boundary: punctures
-    /// close, the wide opening of an open surface stays open. Default
-    /// `roar_ops::init::ENCLOSURE_MAX_CAP_FRACTION` (0.02); 1 closes every opening.
-    pub enclosure_max_cap_fraction: f64,
-    /// Subdivision level of the sphere init. Default 4 (§4.2 has 2; more helps a sphere reach
-    /// detail).
-    pub sphere_level: u32,
-    /// Cells along the longest side of an SDF input's bounds for its voxel init (§4.3: 64).
-    pub sdf_init_resolution: usize,
-}
-
-impl Default for InitConfig {
-    fn default() -> Self {
-        Self {
-            kind: InitKind::Watertight,
-            init_resolution: 192,
-            init_max_faces: 20_000,
-            enclosure_winding_threshold: roar_ops::init::ENCLOSURE_WINDING_THRESHOLD,
-            enclosure_max_cap_fraction: roar_ops::init::ENCLOSURE_MAX_CAP_FRACTION,
-            sphere_level: 4,
-            sdf_init_resolution: 64,
-        }
+config_table! {
+    /// `[init]`: the initial mesh M0.
+    pub struct InitConfig("init") {
+        /// Initial mesh.
+        kind: InitKind = InitKind::Watertight;
+        /// Voxels along the longest axis of the watertight init (in place of Manifold's octree
+        /// resolution). The init closes gaps of about one voxel and the loop never changes the
+        /// genus, so this decides which slots and holes of the input survive. Above `roar
+        /// init`'s 128 (`roar_ops::init::InitOptions::default()`), which fills slots a
+        /// reconstruction should keep, such as those between a chair's slats (why:
+        /// `docs/method.md`, defaults table).
+        init_resolution: usize = 192, range(8.0, 1024.0);
+        /// The init is decimated to at most this many faces.
+        init_max_faces: usize = InitialMeshOptions::default().max_faces, range(4.0, 1e7);
+        /// Enclosure rule of the watertight init (`roar_ops::init::winding_solid`; 0 = off):
+        /// exterior voxels whose generalized winding number with respect to T′ is above this
+        /// value turn solid, so punctures of a closed surface close while tunnels stay.
+        enclosure_winding_threshold: f64 = ENCLOSURE_WINDING_THRESHOLD, zero_or(0.5, 1.0);
+        /// A region the enclosure rule fills stays filled only if its widest cap (a patch of its
+        /// boundary no input surface covers) is at most this fraction of its boundary: punctures
+        /// close, the wide opening of an open surface stays open (1 closes every opening).
+        enclosure_max_cap_fraction: f64 = ENCLOSURE_MAX_CAP_FRACTION, range(0.0, 1.0);
+        /// Subdivision level of the sphere init. Finer than the paper's level 2, so that a sphere
+        /// can reach detail.
+        sphere_level: u32 = 4, range(0.0, 8.0);
+        /// Cells along the longest side of an SDF input's bounds for its voxel init.
+        sdf_init_resolution: usize = SdfInitOptions::default().resolution, range(2.0, 1024.0);
     }
 }
 
-/// `[loss]`
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(default, deny_unknown_fields)]
-pub struct LossConfig {
-    /// λ1, the render loss weight (§3.2.3: 3).
-    pub render_weight: f64,
-    /// λ2, the planar projection loss weight (§3.2.3: 1).
-    pub planar_weight: f64,
-    /// Scale of the planar term before its weight (Verification note 2). Measured with
-    /// `crates/roar-cli/examples/loss_balance.rs` on wild meshes' inits at 5k faces: mean per-vertex gradient of
-    /// 3·render ≈ 3.1e-3, raw planar ≈ 1.3e-6–3.1e-6, Laplacian ≈ 3e-4–6e-4; at 500 the planar
-    /// term (6e-4–1.5e-3) is within 5× of the render term instead of 500× below it.
-    pub planar_scale: f64,
-    /// Source samples kept per planar loss evaluation (§3.2.2 cap; the default and why:
-    /// `roar_loss::planar::DEFAULT_MAX_SAMPLES`; 50,000 in the SDF and scan schedules).
-    pub planar_max_samples: usize,
-    /// Neighbours of the k-NN planar projection (§8: s2t_neighbours 10).
-    pub planar_neighbours: usize,
-    /// Include the target-to-source term (OQ-3).
-    pub planar_t2s: bool,
-    /// Target points the t2s term queries per evaluation, a different spatially even subset
-    /// each time (0: all, the paper's; the default and why:
-    /// `roar_loss::planar::DEFAULT_T2S_MAX_POINTS`; 0 in the SDF and scan schedules).
-    pub planar_t2s_max_points: usize,
-    /// Side in pixels of the coarse views the render loss uses for the loop's first
-    /// `render_coarse_fraction` of iterations (and the polish, see `render_coarse_polish`), when
-    /// below `render_resolution`
-    /// (`roar_loss::CoarseViews`; the paper renders every iteration at `render_resolution`,
-    /// `docs/method.md` says why not). Default 256.
-    pub render_coarse_resolution: u32,
-    /// Fraction of the loop's iterations rendered at `render_coarse_resolution`, from the
-    /// first (0: none, the paper's schedule). Default 1: the whole loop; 0 in the SDF and scan
-    /// schedules.
-    pub render_coarse_fraction: f64,
-    /// When the whole loop renders at `render_coarse_resolution`, the finish's polish does too
-    /// (false: the polish renders at `render_resolution`). Default true (`docs/method.md` has
-    /// the cost and the fidelity of both).
-    pub render_coarse_polish: bool,
-    /// Weight of the SDF projection loss (§5: 0.1), in the objective only for inputs with a
-    /// signed distance (`roar_loss::SdfLoss`).
-    pub sdf_loss_weight: f64,
-    /// Loop iteration from which the SDF loss is on (§5: 500 of the SDF schedule's 700).
-    pub sdf_loss_start: usize,
-    /// `ε` of the SDF loss's projection `v − f ∇f/(|∇f|² + ε)`.
-    pub sdf_loss_epsilon: f64,
-}
-
-impl Default for LossConfig {
-    fn default() -> Self {
-        Self {
-            render_weight: 3.0,
-            planar_weight: 1.0,
-            planar_scale: 500.0,
-            planar_max_samples: roar_loss::planar::DEFAULT_MAX_SAMPLES,
-            planar_neighbours: 10,
-            planar_t2s: true,
-            planar_t2s_max_points: roar_loss::planar::DEFAULT_T2S_MAX_POINTS,
-            render_coarse_resolution: 256,
-            render_coarse_fraction: 1.0,
-            render_coarse_polish: true,
-            sdf_loss_weight: 0.1,
-            sdf_loss_start: 500,
-            sdf_loss_epsilon: 1e-10,
-        }
+config_table! {
+    /// `[loss]`: the loss the loop minimises.
+    pub struct LossConfig("loss") {
+        /// λ1, the weight of the render loss.
+        render_weight: f64 = 3.0, range(0.0, 1e6);
+        /// λ2, the weight of the planar projection loss.
+        planar_weight: f64 = 1.0, range(0.0, 1e6);
+        /// Scale of the planar term before its weight. The library's `PlanarOptions::default()`
+        /// scale (`SPHERE_BALANCED_PLANAR_SCALE`, 5) balances the terms on a sphere; on a real
+        /// input's init the raw planar gradient is far smaller against the render gradient
+        /// (why: `docs/method.md`, defaults table).
+        planar_scale: f64 = RECONSTRUCTION_PLANAR_SCALE, range(0.0, 1e9);
+        /// Source samples kept per planar loss evaluation (50,000 in the SDF and scan
+        /// schedules). The paper samples at a fixed density without a cap (why:
+        /// `docs/method.md`, defaults table).
+        planar_max_samples: usize = DEFAULT_MAX_SAMPLES, range(1.0, 1e8);
+        /// Neighbours of the k-NN planar projection.
+        planar_neighbours: usize = KnnOptions::default().k, range(1.0, 100.0);
+        /// Include the target-to-source (t2s) term of the planar loss.
+        planar_t2s: bool = PlanarOptions::default().t2s;
+        /// Target points the t2s term queries per evaluation, a different spatially even subset
+        /// each time (0 = all, as the paper does; 0 in the SDF and scan schedules) (why:
+        /// `docs/method.md`, defaults table).
+        planar_t2s_max_points: usize = DEFAULT_T2S_MAX_POINTS, range(0.0, 1e9);
+        /// Side in pixels of the coarse views the render loss uses for the loop's first
+        /// `render_coarse_fraction` of iterations (and the polish, see `render_coarse_polish`),
+        /// when below `target.render_resolution` (`roar_loss::CoarseViews`). The paper renders
+        /// every iteration at full resolution; roar does not (why: `docs/method.md`, defaults
+        /// table).
+        render_coarse_resolution: u32 = 256, range(16.0, 4096.0);
+        /// Fraction of the loop's iterations rendered at `render_coarse_resolution`, from the
+        /// first (0 = none, the paper's schedule, and the SDF and scan schedules'; 1 = the whole
+        /// loop).
+        render_coarse_fraction: f64 = 1.0, range(0.0, 1.0);
+        /// When the whole loop renders at `render_coarse_resolution`, the finish's polish does
+        /// too (false: the polish renders at `target.render_resolution`) (why: `docs/method.md`,
+        /// defaults table).
+        render_coarse_polish: bool = true;
+        /// Weight of the SDF projection loss, in the objective only for inputs with a signed
+        /// distance (`roar_loss::SdfLoss`).
+        sdf_loss_weight: f64 = 0.1, range(0.0, 1e6);
+        /// Loop iteration from which the SDF loss is on.
+        sdf_loss_start: usize = SdfLossOptions::default().start_iteration, range(0.0, 1e5);
+        /// `ε` of the SDF loss's projection `v − f ∇f/(|∇f|² + ε)`, and of the finish's
+        /// first-order distances to the zero set.
+        sdf_loss_epsilon: f64 = SdfLossOptions::default().epsilon, range(0.0, 1.0);
     }
 }
 
-/// `[optimize]`
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(default, deny_unknown_fields)]
-pub struct OptimizeConfig {
-    /// Move Vertices iterations (§1.2 step 5: 200 for ShapeNet).
-    pub iterations: usize,
-    /// Learning rate η (§3.2.4: 0.05).
-    pub learning_rate: f64,
-    /// Laplacian weight of the optimizer (§8: 0.02).
-    pub laplacian_weight: f64,
-    /// Working budget W = clamp(factor·N, min, max), never below N (OQ-11, §1.2 step 6).
-    /// Defaults: factor 2, min 5000, max 20 000.
-    pub working_budget_factor: usize,
-    /// Lower bound of the working budget.
-    pub working_budget_min: usize,
-    /// Upper bound of the working budget.
-    pub working_budget_max: usize,
-    /// Face Collapse block and flips every this many iterations (§1.3: 1).
-    pub collapse_interval: usize,
-    /// Fold estimator slack (§3.6, note 4: 0.6).
-    pub collapse_fold_slack: f64,
-    /// Spare flagged faces whose vertex-derived normal `|n_o(f)| = |Σ_k n_vk| / 3` is below this,
-    /// unless they fold back onto a neighbour ([SUP] "Collapse Face normal threshold" 0.98,
-    /// §3.6 step 1; note 4 makes it a switch; 0 = off). Vertex normals diverge on a crease or
-    /// on a thin part, where collapsing eats the part from its rim. On by default, measured:
-    /// luke-f-16 at 1000 faces, Chamfer/diag 4.3e-3 without (worse than init + QEM, 1.7e-3),
-    /// 1.24e-3 with; trimesh-rabbit and manifoldplus-chair unchanged or slightly better.
-    pub collapse_min_normal_size: f64,
-    /// Face Split block every this many iterations (§1.3: 10).
-    pub split_interval: usize,
-    /// Face split score threshold per sub-triangle (§3.5, note 1: 0.02).
-    pub split_threshold: f64,
-    /// Tangential smoothing every this many iterations of the loop (§1.3, OQ-13 recommend 5;
-    /// 0 = off, the default). [INF] Off, as in the reference code, whose call site is commented
-    /// out (§3.9): measured at 1000 faces, each sweep raised the render loss by about a quarter
-    /// and the optimizer never caught up (cgal-non_manifold_face_graph: render loss 0.011 at
-    /// iteration 20, 0.064 at 200), and the output was much farther from the input
-    /// (Chamfer/diag every 5 / off: cgal-non_manifold_face_graph 2.71e-3 / 1.84e-3, gc-moebius
-    /// 3.05e-3 / 2.16e-3). The triangles are shaped after the final QEM instead
-    /// (`final_smoothing_sweeps`).
-    pub smoothing_interval: usize,
-    /// Every this many iterations, keep a copy of the loop's mesh and its loss (default 5; 10
-    /// in the SDF and scan schedules; 0 = only the last state). The run finishes from the kept
-    /// state with the lowest loss (the last one included) that the untangle block can clear
-    /// (`run.optimize.finished_from_iteration`, `run.optimize.untangle_failures` in the
-    /// report). [INF] Not in the paper: the blocks make the loss rise as well as fall, and after
-    /// it levels off (by iteration 30–50 on the wild meshes at 1000 faces) it can drift up
-    /// (libigl-camelhead: 0.0486 at iteration 50, 0.0535 at 199); and the last state may be a
-    /// tangle the untangle cannot clear. The loop's stop (`level_window`) is tested at the
-    /// checkpoints, so 5 lets it stop up to 5 iterations sooner (`docs/method.md`); the SDF
-    /// schedule's 700 iterations keep every checkpoint in memory, and 10 halves that.
-    pub checkpoint_interval: usize,
-    /// Stop the loop once its loss has levelled off: at a checkpoint, when no checkpoint of the
-    /// last `level_window` iterations has a loss `level_tolerance` (relative) below the lowest
-    /// one before them (0 = always run `iterations`; needs `checkpoint_interval > 0`).
-    /// Defaults 20 and 0.03 (50 and 0.01 in the scan schedule); off in the SDF schedule, whose
-    /// SDF loss starts at iteration 500.
-    /// [INF] Not in the paper: the run finishes from the lowest-loss checkpoint, and on the wild
-    /// meshes the loss levels off by iteration 50–100 (`docs/method.md`, "The loop stops when its
-    /// loss has levelled off").
-    pub level_window: usize,
-    /// See `level_window`.
-    pub level_tolerance: f64,
-    /// Shorten optimizer steps that would make faces intersect (`roar_ops::untangle::limit_steps`),
-    /// so the loop itself keeps the mesh intersection-free where the blocks did.
-    pub step_limiter: bool,
-    /// Let the blocks skip (collapses, flips) or shorten (smoothing moves) operations that would
-    /// make a face intersect another one (`roar_ops::blocks::guard`), so the loop's mesh stays
-    /// intersection-free and every checkpoint is recent. [INF] Not in the paper. Off by default,
-    /// measured: it keeps folds the Face Collapse block would have removed, and the final
-    /// untangle clears what the unguarded blocks leave (gpytoolbox-airplane at 1000 faces:
-    /// Chamfer/diag 3.49e-3 with it, 2.13e-3 without; luke-f-16 1.92e-3 / 1.88e-3). Worth it
-    /// where the untangle fails and the run would finish from an old checkpoint (a 256-voxel
-    /// init of manifoldplus-chair: the collapse, split and smoothing blocks created crossings in
-    /// 88, 19 and 28 of their calls, and the run fell back to its init).
-    pub guard_intersections: bool,
-    /// The Face Split block of an SDF input projects its samples onto the field (§3.4 C, up to
-    /// 6 gradient evaluations per sample) rather than by the k-NN planar projection over the point
-    /// cloud. The spec's choice and on by default; with a neural field it is most of the run's
-    /// evaluations (`docs/sdf.md`, "Measured cost").
-    pub sdf_split_projector: bool,
-}
-
-impl Default for OptimizeConfig {
-    fn default() -> Self {
-        Self {
-            iterations: 200,
-            learning_rate: 0.05,
-            laplacian_weight: 0.02,
-            working_budget_factor: 2,
-            working_budget_min: 5000,
-            working_budget_max: 20_000,
-            collapse_interval: 1,
-            collapse_fold_slack: 0.6,
-            collapse_min_normal_size: 0.98,
-            split_interval: 10,
-            split_threshold: 0.02,
-            smoothing_interval: 0,
-            checkpoint_interval: 5,
-            level_window: 20,
-            level_tolerance: 0.03,
-            step_limiter: true,
-            guard_intersections: false,
-            sdf_split_projector: true,
-        }
+config_table! {
+    /// `[optimize]`: the loop, Move Vertices and its remeshing blocks at the working budget.
+    pub struct OptimizeConfig("optimize") {
+        /// Move Vertices iterations of the loop.
+        iterations: usize = 200, range(0.0, 1e5);
+        /// Learning rate η of the optimizer.
+        learning_rate: f64 = OptimizerOptions::default().lr, range(1e-9, 10.0);
+        /// Weight of the optimizer's Laplacian term.
+        laplacian_weight: f64 = OptimizerOptions::default().laplacian_weight, range(0.0, 1e3);
+        /// The working budget, the face count the loop works at, is W = clamp(factor·N, min,
+        /// max), never below N.
+        working_budget_factor: usize = 2, range(1.0, 100.0);
+        /// Lower bound of the working budget.
+        working_budget_min: usize = 5000, range(4.0, 1e7);
+        /// Upper bound of the working budget.
+        working_budget_max: usize = 20_000, range(4.0, 1e7);
+        /// Face Collapse block and its valence flips every this many iterations (0 = never).
+        collapse_interval: usize = 1, range(0.0, 1e5);
+        /// Slack of the Face Collapse block's fold estimator.
+        collapse_fold_slack: f64 = FaceCollapseOptions::default().fold_slack, range(0.0, 1.0);
+        /// Spare flagged faces whose vertex-derived normal `|n_o(f)| = |Σ_k n_vk| / 3` is below
+        /// this, unless they fold back onto a neighbour (0 = off). Vertex normals diverge on a
+        /// crease or on a thin part, where collapsing eats the part from its rim. Off in the
+        /// library's `FaceCollapseOptions::default()`, on in the pipeline at the threshold of the
+        /// paper's supplement (why: `docs/method.md`, defaults table).
+        collapse_min_normal_size: f64 = 0.98, range(0.0, 1.0);
+        /// Face Split block every this many iterations, never at the first (0 = never).
+        split_interval: usize = 10, range(0.0, 1e5);
+        /// Face Split score threshold per sub-triangle.
+        split_threshold: f64 = DEFAULT_SPLIT_THRESHOLD, range(0.0, 1e3);
+        /// Tangential smoothing every this many iterations of the loop (0 = off). The paper
+        /// recommends 5 but its reference code never calls it; roar follows the code and shapes
+        /// the triangles after the final QEM instead (`finish.final_smoothing_sweeps`) (why:
+        /// `docs/method.md`, defaults table).
+        smoothing_interval: usize = 0, range(0.0, 1e5);
+        /// Every this many iterations, keep a copy of the loop's mesh and its loss (0 = only the
+        /// last state; 10 in the SDF and scan schedules). The run finishes from the kept state
+        /// with the lowest loss (the last one included) that the untangle block can clear
+        /// (`run.optimize.finished_from_iteration`, `run.optimize.untangle_failures` in the
+        /// report), and the loop's stop (`level_window`) is tested at the checkpoints. The paper
+        /// finishes from the last state (why: `docs/method.md`, defaults table).
+        checkpoint_interval: usize = 5, range(0.0, 1e5);
+        /// Stop the loop once its loss has levelled off: at a checkpoint, when no checkpoint of
+        /// the last `level_window` iterations has a loss `level_tolerance` (relative) below the
+        /// lowest one before them (0 = always run `iterations`; needs `checkpoint_interval > 0`;
+        /// 50 in the scan schedule, 0 in the SDF schedule, whose SDF loss starts late). The paper
+        /// always runs every iteration (why: `docs/method.md`, defaults table).
+        level_window: usize = 20, range(0.0, 1e5);
+        /// See `level_window` (0.01 in the scan schedule).
+        level_tolerance: f64 = 0.03, range(0.0, 1.0);
+        /// Shorten optimizer steps that would make faces intersect
+        /// (`roar_ops::untangle::limit_steps`), so the loop itself keeps the mesh
+        /// intersection-free where the blocks did.
+        step_limiter: bool = true;
+        /// Let the blocks skip (collapses, flips) or shorten (smoothing moves) operations that
+        /// would make a face intersect another one (`roar_ops::blocks::guard`), so the loop's
+        /// mesh stays intersection-free and every checkpoint is recent. Not in the paper. Off:
+        /// it keeps folds the Face Collapse block would have removed, and the final untangle
+        /// clears what the unguarded blocks leave; worth turning on where the untangle fails and
+        /// the run would finish from an old checkpoint (why: `docs/method.md`, defaults table).
+        guard_intersections: bool = false;
+        /// The Face Split block of an SDF input projects its samples onto the field, as the paper
+        /// does, rather than by the k-NN planar projection over the point cloud (false). With a
+        /// neural field it is most of the run's evaluations (`docs/sdf.md`).
+        sdf_split_projector: bool = true;
     }
 }
 
-/// `[finish]`
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(default, deny_unknown_fields)]
-pub struct FinishConfig {
-    /// Separation margin of the untangle block, relative to the bounding-box diagonal.
-    pub untangle_margin: f64,
-    /// Before the final QEM, move every vertex this far (relative to the bounding-box diagonal)
-    /// outward along its normal, as far as no intersection appears (default 5e-4; 0 = off; only
-    /// when the polish runs, which moves the vertices back onto the target). [INF] Not in the
-    /// paper: the loop pulls the two sides of a thin part or of an open surface onto one sheet,
-    /// where the QEM's self-intersection veto refuses nearly every collapse and the decimation eats
-    /// the part from its rim instead (libigl-camelhead, an open surface, decimated from its
-    /// 5000-face loop mesh to 1000: 5.9 % of the input farther than 1 % of the diagonal from the
-    /// output, 0.3 % with an offset of 5e-4).
-    pub final_qem_offset: f64,
-    /// Sweeps of tangential smoothing at exactly N after the final QEM, before the polish (default
-    /// 3; 0 = none), each moved vertex put back on its old faces (§3.9 plus projection) and every
-    /// move limited so that no intersection appears. [INF] Not in the paper: with the sweeps off in
-    /// the loop, this is what keeps the output's triangles well shaped. Without it the outputs are
-    /// slightly closer to the input (Chamfer/diag 0.5–1 % lower on gpytoolbox-split_mountain and
-    /// libigl-camelhead at 5000 faces) but worse shaped (median aspect ratio over the 14 wild
-    /// meshes 1.46 with the init at 256 voxels, against 1.26 with the sweeps at 192;
-    /// `docs/method.md`).
-    pub final_smoothing_sweeps: usize,
-    /// Rounds of data-dependent edge flips at exactly N after the smoothing, before the polish
-    /// (default 5; 0 = off): an edge flips when the quad's other diagonal follows the point cloud's
-    /// normals better (`roar_ops::finish::data_flips`), no face gets worse than `Q = 4` (or the
-    /// worse old face) and no intersection appears. [INF] Not in the paper: the valence flips, the
-    /// smoothing and the final QEM choose the diagonals for the triangles' shapes and the working
-    /// mesh's quadrics, not for the target's normals (`docs/method.md`).
-    pub data_flip_rounds: usize,
-    /// Move Vertices iterations at exactly N after the final QEM (default 20; 0 = off), with the
-    /// step limiter, a learning rate falling linearly to 0 and no blocks, so the face count and
-    /// topology stay; the state with the lowest loss is kept. [INF] Not in the paper: the final QEM
-    /// places vertices at quadric minimisers of the working-budget surface, not on the target. If
-    /// the kept mesh intersects itself, the QEM output is kept (the report says so). Runs only when
-    /// `iterations > 0`, so `--iterations 0` stays the plain init + QEM.
-    pub polish_iterations: usize,
-    /// For an input with a signed distance (an SDF), after the polish: this many steps (default
-    /// 3; 0 = off) that move every vertex along its normal by minus the mean first-order distance
-    /// `f/|∇f|` over its faces (sampled at their edge midpoints), except where the move is long
-    /// against its faces, would turn a face over or make faces intersect
-    /// (`roar_ops::finish::zero_set`). [INF] Not in the paper: the loop's mesh is on
-    /// the surface only as far as the losses pull it, and the fill splits to a large budget put
-    /// their vertices on chords (`docs/sdf.md`, "Measured cost"). Soups have no field and skip
-    /// it. Runs only when `iterations > 0`.
-    pub zero_set_steps: usize,
-    /// For an SDF input, before the fit to the zero set: a vertex whose first-order distance
-    /// `|f|/|∇f|` from the zero set exceeds this times its mean edge length is collapsed into a
-    /// neighbour (the nearest to the zero set first) where no face turns over and no
-    /// intersection appears, and the face count is restored by edge splits
-    /// (`roar_ops::finish::fins`; default 0.5; 0 = off). [INF] Not in the paper: the untangle
-    /// can leave fins, flaps of faces standing off the surface that the fit would fold onto
-    /// themselves and so holds (`docs/sdf.md`). Runs only when `iterations > 0`.
-    pub fin_distance_over_edge: f64,
-    /// Last step: flip the edges of faces with aspect ratio `Q = R/(2r)` above this when both faces
-    /// of the edge get better, the two are nearly coplanar (0.95; against the other face alone when
-    /// one is degenerate, above 100) and no intersection appears (`roar_ops::finish::slivers`;
-    /// default 10; 0 = off); then degenerate faces (above 100) that no flip fixes are removed by
-    /// collapsing one of their edges, and the face count is restored by edge splits that make no
-    /// degenerate face (`roar_ops::finish::degenerate`). [INF] Not in the paper: the optimization
-    /// and the polish move vertices for the losses, and the final QEM bounds only the faces it
-    /// creates, so a few caps (one angle near 180°) reach the output. Runs only when `iterations >
-    /// 0`.
-    pub sliver_quality: f64,
-    /// Write the closest mesh when the final QEM cannot reach the budget, instead of failing.
-    pub best_effort: bool,
-    /// Keep the init's genus to the end: when the budget is too small for it (or the final QEM
-    /// stalls on the link condition) the run fails with the QEM's named error instead of
-    /// removing handles (`roar_ops::finish::genus`; DESIGN.md §2).
-    pub keep_topology: bool,
-}
-
-impl Default for FinishConfig {
-    fn default() -> Self {
-        Self {
-            untangle_margin: 1e-6,
-            final_qem_offset: 5e-4,
-            final_smoothing_sweeps: 3,
-            data_flip_rounds: 5,
-            polish_iterations: 20,
-            zero_set_steps: 3,
-            fin_distance_over_edge: 0.5,
-            sliver_quality: 10.0,
-            best_effort: false,
-            keep_topology: false,
-        }
+config_table! {
+    /// `[finish]`: from the loop's mesh to exactly `faces` faces.
+    pub struct FinishConfig("finish") {
+        /// Separation margin of the untangle block, relative to the bounding-box diagonal.
+        untangle_margin: f64 = UntangleOptions::default().margin_rel, range(0.0, 0.01);
+        /// Before the final QEM, move every vertex this far (relative to the bounding-box
+        /// diagonal) outward along its normal, as far as no intersection appears (0 = off; only
+        /// when the polish runs, which moves the vertices back onto the target). The loop pulls
+        /// the two sides of a thin part or of an open surface onto one sheet, where the QEM's
+        /// self-intersection veto refuses nearly every collapse and the decimation eats the part
+        /// from its rim instead. Not in the paper (why: `docs/method.md`, defaults table).
+        final_qem_offset: f64 = 5e-4, range(0.0, 0.1);
+        /// Sweeps of tangential smoothing at exactly N after the final QEM, before the polish
+        /// (0 = none), each moved vertex put back on its old faces and every move limited so
+        /// that no intersection appears. With the sweeps off in the loop, this is what keeps the
+        /// output's triangles well shaped. Not in the paper (why: `docs/method.md`, defaults
+        /// table).
+        final_smoothing_sweeps: usize = 3, range(0.0, 1e3);
+        /// Rounds of data-dependent edge flips at exactly N after the smoothing, before the
+        /// polish (0 = off): an edge flips when the quad's other diagonal follows the point
+        /// cloud's normals better (`roar_ops::finish::data_flips`), no face gets worse than
+        /// `Q = 4` (or the worse old face) and no intersection appears. The valence flips, the
+        /// smoothing and the final QEM choose the diagonals for the triangles' shapes, not for
+        /// the target's normals. Not in the paper (why: `docs/method.md`, defaults table).
+        data_flip_rounds: usize = DataFlipOptions::default().max_rounds, range(0.0, 1e3);
+        /// Move Vertices iterations at exactly N after the final QEM (0 = off), with the step
+        /// limiter, a learning rate falling linearly to 0 and no blocks, so the face count and
+        /// topology stay; the state with the lowest loss is kept. If the kept mesh intersects
+        /// itself, the QEM output is kept (the report says so). Runs only when `iterations > 0`,
+        /// so `--iterations 0` stays the plain init + QEM. Not in the paper, whose final QEM
+        /// leaves the vertices at quadric minimisers of the working-budget surface, off the
+        /// target (why: `docs/method.md`, defaults table).
+        polish_iterations: usize = 20, range(0.0, 1e5);
+        /// For an input with a signed distance (an SDF), after the polish: this many steps
+        /// (0 = off) that move every vertex along its normal by minus the mean first-order
+        /// distance `f/|∇f|` over its faces (sampled at their edge midpoints), except where the
+        /// move is long against its faces, would turn a face over or make faces intersect
+        /// (`roar_ops::finish::zero_set`). The loop's mesh is on the surface only as far as the
+        /// losses pull it. Soups have no field and skip it; runs only when `iterations > 0`. Not
+        /// in the paper (why: `docs/method.md`, defaults table).
+        zero_set_steps: usize = ZeroSetOptions::default().steps, range(0.0, 100.0);
+        /// For an SDF input, before the fit to the zero set: a vertex whose first-order distance
+        /// `|f|/|∇f|` from the zero set exceeds this times its mean edge length is collapsed
+        /// into a neighbour (the nearest to the zero set first) where no face turns over and no
+        /// intersection appears, and the face count is restored by edge splits
+        /// (`roar_ops::finish::fins`; 0 = off). The untangle can leave fins, flaps of faces
+        /// standing off the surface that the fit would fold onto themselves. Runs only when
+        /// `iterations > 0`. Not in the paper.
+        fin_distance_over_edge: f64 = FinOptions::default().max_distance_over_edge,
+            zero_or(0.01, 100.0);
+        /// Last step: flip the edges of faces with aspect ratio `Q = R/(2r)` above this when
+        /// both faces of the edge get better, the two are nearly coplanar and no intersection
+        /// appears (`roar_ops::finish::slivers`; 0 = off); then degenerate faces that no flip
+        /// fixes are removed by collapsing one of their edges, and the face count is restored by
+        /// edge splits that make no degenerate face (`roar_ops::finish::degenerate`). The
+        /// optimization and the polish move vertices for the losses and the final QEM bounds
+        /// only the faces it creates, so a few caps would reach the output. Runs only when
+        /// `iterations > 0`. Not in the paper.
+        sliver_quality: f64 = SliverOptions::default().max_quality, zero_or(1.0, 1e6);
+        /// Write the closest mesh when the final QEM cannot reach the budget, instead of
+        /// failing.
+        best_effort: bool = false;
+        /// Keep the init's genus to the end: when the budget is too small for it (or the final
+        /// QEM stalls on the link condition) the run fails with the QEM's named error instead of
+        /// removing handles (`roar_ops::finish::genus`).
+        keep_topology: bool = false;
     }
 }
 
 impl ReconstructConfig {
-    /// The SDF schedule of spec §5, the defaults for signed distance inputs: the full pipeline
+    /// The paper's SDF schedule, the defaults for signed distance inputs: the full pipeline
     /// with 700 iterations and 50k faces, the SDF loss on from iteration 500, every iteration
     /// on the full rig and run (no stop when the loss levels off before the SDF loss starts).
     pub fn sdf_defaults() -> Self {
@@ -488,7 +489,7 @@ impl ReconstructConfig {
         self.loss.planar_t2s_max_points = 0;
     }
 
-    /// W = clamp(factor·N, min, max), never below N (DESIGN.md §2).
+    /// W = clamp(factor·N, min, max), never below N, rounded up to even.
     pub fn working_budget(&self) -> usize {
         let w = (self.optimize.working_budget_factor * self.faces)
             .max(self.optimize.working_budget_min)
@@ -500,23 +501,23 @@ impl ReconstructConfig {
     /// Checks every numeric field against its range ([`ReconstructConfig::field_ranges`]) and
     /// the rules between fields, before any work; the one-line error names the field, its value
     /// and what is allowed. NaN and infinities are outside every range.
-    pub fn validate(&self) -> Result<(), String> {
-        crate::budget::check_budget("faces =", self.faces, 4).map_err(|e| e.to_string())?;
+    pub fn validate(&self) -> Result<(), ConfigError> {
+        crate::budget::check_budget("faces =", self.faces, 4)?;
         for (range, value) in self.field_ranges() {
             if !range.allows(value) {
-                return Err(format!(
-                    "{} = {} is out of range: allowed {}",
-                    range.name,
+                return Err(ConfigError::OutOfRange {
+                    name: range.name,
                     value,
-                    range.describe()
-                ));
+                    allowed: range,
+                });
             }
         }
-        if self.optimize.working_budget_min > self.optimize.working_budget_max {
-            return Err(format!(
-                "optimize.working_budget_min = {} is above optimize.working_budget_max = {}",
-                self.optimize.working_budget_min, self.optimize.working_budget_max
-            ));
+        let optimize = &self.optimize;
+        if optimize.working_budget_min > optimize.working_budget_max {
+            return Err(ConfigError::WorkingBudgetBounds {
+                min: optimize.working_budget_min,
+                max: optimize.working_budget_max,
+            });
         }
         Ok(())
     }
@@ -524,234 +525,122 @@ impl ReconstructConfig {
     /// The config of a TOML file: `defaults` with the file's keys over them, table by table.
     /// Errors are one line: a key of another table (or a flat key of the ungrouped layout) names
     /// the table it belongs in, a bad value its line. Does not [`validate`](Self::validate).
-    pub fn from_toml(text: &str, defaults: &Self) -> Result<Self, String> {
-        let file: toml::Table = toml::from_str(text).map_err(one_line)?;
+    pub fn from_toml(text: &str, defaults: &Self) -> Result<Self, ConfigError> {
+        let file: toml::Table = toml::from_str(text)?;
         check_layout(&file)?;
         // Parsed alone, so a bad value is named with its line in the file.
-        toml::from_str::<Self>(text).map_err(one_line)?;
+        toml::from_str::<Self>(text)?;
         merge_over(file, defaults)
     }
 
     /// Like [`from_toml`](Self::from_toml) for a table already parsed (the Python package's dict).
-    pub fn from_table(file: toml::Table, defaults: &Self) -> Result<Self, String> {
+    pub fn from_table(file: toml::Table, defaults: &Self) -> Result<Self, ConfigError> {
         check_layout(&file)?;
         merge_over(file, defaults)
     }
 
     /// Every numeric field with its allowed range and its current value, named as the messages
-    /// name it (`loss.render_weight`).
+    /// name it (`loss.render_weight`): `faces` and `seed`, then each table's fields in order.
     /// The ranges are wide: they refuse what cannot mean anything (NaN, infinities, negative
     /// weights, zero samples, huge values that would exhaust memory or time), not what is merely
     /// unusual. `0 (off)` marks the fields where 0 switches a feature off, as their docs say.
     pub fn field_ranges(&self) -> Vec<(FieldRange, f64)> {
-        let r = FieldRange::new;
-        let off = FieldRange::zero_or;
-        vec![
-            (r("faces", 4.0, 1e9), self.faces as f64),
-            (r("seed", 0.0, u64::MAX as f64), self.seed as f64),
+        let mut ranges = vec![
+            (FieldRange::new("faces", 4.0, 1e9), self.faces as f64),
             (
-                r("optimize.iterations", 0.0, 1e5),
-                self.optimize.iterations as f64,
+                FieldRange::new("seed", 0.0, u64::MAX as f64),
+                self.seed as f64,
             ),
-            (
-                r("init.init_resolution", 8.0, 1024.0),
-                self.init.init_resolution as f64,
-            ),
-            (
-                r("init.init_max_faces", 4.0, 1e7),
-                self.init.init_max_faces as f64,
-            ),
-            (
-                off("init.enclosure_winding_threshold", 0.5, 1.0),
-                self.init.enclosure_winding_threshold,
-            ),
-            (
-                r("init.enclosure_max_cap_fraction", 0.0, 1.0),
-                self.init.enclosure_max_cap_fraction,
-            ),
-            (
-                r("init.sphere_level", 0.0, 8.0),
-                f64::from(self.init.sphere_level),
-            ),
-            (
-                r("target.scan_max_edge_factor", 1.0, 1e3),
-                self.target.scan_max_edge_factor,
-            ),
-            (
-                r("target.scan_max_angle_degrees", 1.0, 90.0),
-                self.target.scan_max_angle_degrees,
-            ),
-            (
-                r("optimize.working_budget_factor", 1.0, 100.0),
-                self.optimize.working_budget_factor as f64,
-            ),
-            (
-                r("optimize.working_budget_min", 4.0, 1e7),
-                self.optimize.working_budget_min as f64,
-            ),
-            (
-                r("optimize.working_budget_max", 4.0, 1e7),
-                self.optimize.working_budget_max as f64,
-            ),
-            (
-                r("target.views_per_axis", 1.0, 32.0),
-                self.target.views_per_axis as f64,
-            ),
-            (
-                r("target.render_resolution", 16.0, 4096.0),
-                f64::from(self.target.render_resolution),
-            ),
-            (r("target.twin_ratio", 1.0, 1e6), self.target.twin_ratio),
-            (r("loss.render_weight", 0.0, 1e6), self.loss.render_weight),
-            (
-                r("loss.render_coarse_resolution", 16.0, 4096.0),
-                f64::from(self.loss.render_coarse_resolution),
-            ),
-            (
-                r("loss.render_coarse_fraction", 0.0, 1.0),
-                self.loss.render_coarse_fraction,
-            ),
-            (r("loss.planar_weight", 0.0, 1e6), self.loss.planar_weight),
-            (r("loss.planar_scale", 0.0, 1e9), self.loss.planar_scale),
-            (
-                r("loss.planar_max_samples", 1.0, 1e8),
-                self.loss.planar_max_samples as f64,
-            ),
-            (
-                r("loss.planar_neighbours", 1.0, 100.0),
-                self.loss.planar_neighbours as f64,
-            ),
-            (
-                r("loss.planar_t2s_max_points", 0.0, 1e9),
-                self.loss.planar_t2s_max_points as f64,
-            ),
-            (
-                r("target.point_cloud_samples", 100.0, 5e7),
-                self.target.point_cloud_samples as f64,
-            ),
-            (
-                r("target.winding_threshold", 1e-6, 1.0),
-                self.target.winding_threshold,
-            ),
-            (r("target.sheet_offset", 0.0, 0.1), self.target.sheet_offset),
-            (
-                r("target.sharp_edge_samples", 0.0, 5e7),
-                self.target.sharp_edge_samples as f64,
-            ),
-            (
-                r("optimize.learning_rate", 1e-9, 10.0),
-                self.optimize.learning_rate,
-            ),
-            (
-                r("optimize.laplacian_weight", 0.0, 1e3),
-                self.optimize.laplacian_weight,
-            ),
-            (
-                r("optimize.collapse_interval", 0.0, 1e5),
-                self.optimize.collapse_interval as f64,
-            ),
-            (
-                r("optimize.collapse_fold_slack", 0.0, 1.0),
-                self.optimize.collapse_fold_slack,
-            ),
-            (
-                r("optimize.collapse_min_normal_size", 0.0, 1.0),
-                self.optimize.collapse_min_normal_size,
-            ),
-            (
-                r("optimize.split_interval", 0.0, 1e5),
-                self.optimize.split_interval as f64,
-            ),
-            (
-                r("optimize.split_threshold", 0.0, 1e3),
-                self.optimize.split_threshold,
-            ),
-            (
-                r("optimize.smoothing_interval", 0.0, 1e5),
-                self.optimize.smoothing_interval as f64,
-            ),
-            (
-                r("finish.final_smoothing_sweeps", 0.0, 1e3),
-                self.finish.final_smoothing_sweeps as f64,
-            ),
-            (
-                r("finish.data_flip_rounds", 0.0, 1e3),
-                self.finish.data_flip_rounds as f64,
-            ),
-            (
-                r("optimize.checkpoint_interval", 0.0, 1e5),
-                self.optimize.checkpoint_interval as f64,
-            ),
-            (
-                r("optimize.level_window", 0.0, 1e5),
-                self.optimize.level_window as f64,
-            ),
-            (
-                r("optimize.level_tolerance", 0.0, 1.0),
-                self.optimize.level_tolerance,
-            ),
-            (
-                r("finish.untangle_margin", 0.0, 0.01),
-                self.finish.untangle_margin,
-            ),
-            (
-                r("finish.final_qem_offset", 0.0, 0.1),
-                self.finish.final_qem_offset,
-            ),
-            (
-                r("finish.polish_iterations", 0.0, 1e5),
-                self.finish.polish_iterations as f64,
-            ),
-            (
-                r("finish.zero_set_steps", 0.0, 100.0),
-                self.finish.zero_set_steps as f64,
-            ),
-            (
-                off("finish.fin_distance_over_edge", 0.01, 100.0),
-                self.finish.fin_distance_over_edge,
-            ),
-            (
-                off("finish.sliver_quality", 1.0, 1e6),
-                self.finish.sliver_quality,
-            ),
-            (
-                r("loss.sdf_loss_weight", 0.0, 1e6),
-                self.loss.sdf_loss_weight,
-            ),
-            (
-                r("loss.sdf_loss_start", 0.0, 1e5),
-                self.loss.sdf_loss_start as f64,
-            ),
-            (
-                r("loss.sdf_loss_epsilon", 0.0, 1.0),
-                self.loss.sdf_loss_epsilon,
-            ),
-            (
-                r("init.sdf_init_resolution", 2.0, 1024.0),
-                self.init.sdf_init_resolution as f64,
-            ),
-            (
-                r("target.sdf_trace_grid", 2.0, 2048.0),
-                self.target.sdf_trace_grid as f64,
-            ),
-            (
-                r("target.sdf_trace_refine_steps", 0.0, 100.0),
-                self.target.sdf_trace_refine_steps as f64,
-            ),
-            (
-                r("target.sdf_projection_steps", 1.0, 100.0),
-                self.target.sdf_projection_steps as f64,
-            ),
-            (
-                r("target.sdf_projection_tolerance", 1e-12, 1.0),
-                self.target.sdf_projection_tolerance,
-            ),
-        ]
+        ];
+        ranges.extend(self.target.field_ranges());
+        ranges.extend(self.init.field_ranges());
+        ranges.extend(self.loss.field_ranges());
+        ranges.extend(self.optimize.field_ranges());
+        ranges.extend(self.finish.field_ranges());
+        ranges
+    }
+}
+
+/// Why a configuration was refused. Every message is one line, naming the key to fix (the CLI
+/// and the Python package print it after `config: `, or after the file's path for a TOML error).
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum ConfigError {
+    /// A numeric field is outside its range (NaN and infinities are outside every range).
+    #[error("{name} = {value} is out of range: allowed {allowed}")]
+    OutOfRange {
+        /// The field's dotted name (`loss.render_weight`).
+        name: &'static str,
+        /// The refused value.
+        value: f64,
+        /// The values the field may take.
+        allowed: FieldRange,
+    },
+    /// `optimize.working_budget_min` is above `optimize.working_budget_max`.
+    #[error("optimize.working_budget_min = {min} is above optimize.working_budget_max = {max}")]
+    WorkingBudgetBounds {
+        /// `optimize.working_budget_min`.
+        min: usize,
+        /// `optimize.working_budget_max`.
+        max: usize,
+    },
+    /// `faces` is odd or below a tetrahedron's 4.
+    #[error(transparent)]
+    Budget(#[from] BudgetError),
+    /// `faces` is below what the init's pieces need (known only once the init is made).
+    #[error("{0} (for the pieces of the init)")]
+    BudgetForInit(BudgetError),
+    /// A key outside the table it belongs in: a flat key of the ungrouped layout, or a key under
+    /// another table.
+    #[error(
+        "`{key}` {}: it belongs in the [{table}] table (write it under [{table}])",
+        not_a_key_of(.found_in)
+    )]
+    MisplacedKey {
+        /// The key.
+        key: String,
+        /// The table it was found in (`None`: at the top level).
+        found_in: Option<String>,
+        /// The table it belongs in.
+        table: String,
+    },
+    /// `init` (the ungrouped layout's initial mesh kind), which is now `kind` in `[init]`.
+    #[error(
+        "`init` {}: the initial mesh's kind is `kind` in the [init] table",
+        not_a_key_of(.found_in)
+    )]
+    InitKey {
+        /// The table it was found in (`None`: at the top level).
+        found_in: Option<String>,
+    },
+    /// The text is not TOML, or a key is unknown or has a value of the wrong type; the message
+    /// is the parser's, on one line, with the line of the file it refers to.
+    #[error("{}", one_line(.0))]
+    Toml(toml::de::Error),
+    /// The defaults could not be written as a TOML table to merge a file over (a bug).
+    #[error(transparent)]
+    Layout(#[from] toml::ser::Error),
+    /// The optimizer refused the learning rate or the Laplacian weight.
+    #[error(transparent)]
+    Optimizer(#[from] OptimError),
+}
+
+// Not `#[from]`: the TOML error is the message itself, not a cause to print after it.
+impl From<toml::de::Error> for ConfigError {
+    fn from(error: toml::de::Error) -> Self {
+        ConfigError::Toml(error)
+    }
+}
+
+/// Where a misplaced key was found, for [`ConfigError`]'s messages.
+fn not_a_key_of(table: &Option<String>) -> String {
+    match table {
+        Some(table) => format!("is not a key of [{table}]"),
+        None => "is not a top-level key".to_string(),
     }
 }
 
 /// A TOML error on one line, for the CLI's one-line messages.
-fn one_line(e: toml::de::Error) -> String {
+fn one_line(e: &toml::de::Error) -> String {
     e.to_string().replace('\n', " ").trim().to_string()
 }
 
@@ -760,8 +649,8 @@ fn one_line(e: toml::de::Error) -> String {
 fn merge_over(
     file: toml::Table,
     defaults: &ReconstructConfig,
-) -> Result<ReconstructConfig, String> {
-    let mut merged = toml::Table::try_from(defaults).map_err(|e| e.to_string())?;
+) -> Result<ReconstructConfig, ConfigError> {
+    let mut merged = toml::Table::try_from(defaults)?;
     for (key, value) in file {
         match (merged.get_mut(&key), value) {
             (Some(toml::Value::Table(table)), toml::Value::Table(keys)) => table.extend(keys),
@@ -770,29 +659,32 @@ fn merge_over(
             }
         }
     }
-    merged.try_into().map_err(one_line)
+    Ok(merged.try_into()?)
 }
 
 /// Refuses a key outside the table it belongs in, naming that table: the flat keys of the
 /// ungrouped layout (`render_weight = 3` at the top) and keys under the wrong table.
-fn check_layout(file: &toml::Table) -> Result<(), String> {
-    let layout = toml::Table::try_from(ReconstructConfig::default()).map_err(|e| e.to_string())?;
+fn check_layout(file: &toml::Table) -> Result<(), ConfigError> {
+    let layout = toml::Table::try_from(ReconstructConfig::default())?;
     let home = |key: &str| {
         layout.iter().find_map(|(table, value)| match value {
-            toml::Value::Table(leaves) if leaves.contains_key(key) => Some(table.as_str()),
+            toml::Value::Table(leaves) if leaves.contains_key(key) => Some(table.clone()),
             _ => None,
         })
     };
-    let misplaced = |key: &str, here: &str| -> Result<(), String> {
+    // A key found in `found_in` (`None`: the top level) where it is not a key: refused if it
+    // belongs in another table; an unknown key is left to the parser.
+    let misplaced = |key: &str, found_in: Option<&String>| -> Result<(), ConfigError> {
+        let found_in = found_in.cloned();
         if key == "init" {
-            return Err(format!(
-                "`init` {here}: the initial mesh's kind is `kind` in the [init] table"
-            ));
+            return Err(ConfigError::InitKey { found_in });
         }
         match home(key) {
-            Some(table) => Err(format!(
-                "`{key}` {here}: it belongs in the [{table}] table (write it under [{table}])"
-            )),
+            Some(table) => Err(ConfigError::MisplacedKey {
+                key: key.to_string(),
+                found_in,
+                table,
+            }),
             None => Ok(()),
         }
     };
@@ -801,12 +693,12 @@ fn check_layout(file: &toml::Table) -> Result<(), String> {
             (Some(toml::Value::Table(_)), toml::Value::Table(keys)) => {
                 for leaf in keys.keys() {
                     if !layout[key].as_table().is_some_and(|t| t.contains_key(leaf)) {
-                        misplaced(leaf, &format!("is not a key of [{key}]"))?;
+                        misplaced(leaf, Some(key))?;
                     }
                 }
             }
             (Some(toml::Value::Table(_)), _) | (None, _) => {
-                misplaced(key, "is not a top-level key")?;
+                misplaced(key, None)?;
             }
             _ => {}
         }
@@ -852,14 +744,18 @@ impl FieldRange {
         (self.zero_is_off && value == 0.0) || (value >= self.min && value <= self.max)
     }
 
-    /// The range in words, for messages: `0 (off) or 1 to 1000000`.
+    /// The range in words, for messages: `0 (off) or 1 to 1000000` (its `Display`).
     pub fn describe(&self) -> String {
-        let span = format!("{} to {}", self.min, self.max);
+        self.to_string()
+    }
+}
+
+impl std::fmt::Display for FieldRange {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         if self.zero_is_off {
-            format!("0 (off) or {span}")
-        } else {
-            span
+            write!(f, "0 (off) or ")?;
         }
+        write!(f, "{} to {}", self.min, self.max)
     }
 }
 
@@ -900,7 +796,20 @@ mod tests {
     #[test]
     fn misplaced_keys_name_their_table() {
         let d = ReconstructConfig::default();
-        let refused = |text: &str| ReconstructConfig::from_toml(text, &d).unwrap_err();
+        let refused = |text: &str| {
+            ReconstructConfig::from_toml(text, &d)
+                .unwrap_err()
+                .to_string()
+        };
+        let typed = ReconstructConfig::from_toml("render_weight = 2.0\n", &d).unwrap_err();
+        assert_eq!(
+            typed,
+            ConfigError::MisplacedKey {
+                key: "render_weight".to_string(),
+                found_in: None,
+                table: "loss".to_string(),
+            }
+        );
         let e = refused("render_weight = 2.0\n");
         assert!(e.contains("`render_weight`") && e.contains("[loss]"), "{e}");
         let e = refused("[loss]\niterations = 3\n");
@@ -921,10 +830,12 @@ mod tests {
         assert_eq!(sphere.init.kind, InitKind::Sphere);
     }
 
-    /// The defaults the field docs (and `docs/method.md`) state, so the two cannot drift apart.
+    /// The defaults `docs/method.md`'s defaults table (and the field docs) state, so they cannot
+    /// drift apart, and the library defaults the field docs say the pipeline departs from.
     #[test]
     fn documented_defaults() {
         let c = ReconstructConfig::default();
+        assert_eq!(c.faces, 5000);
         assert_eq!(c.seed, 43);
         assert_eq!(c.optimize.iterations, 200);
         assert_eq!(c.init.kind, InitKind::Watertight);
@@ -1021,5 +932,33 @@ mod tests {
         assert_eq!(c.finish.polish_iterations, 20);
         assert_eq!(c.finish.sliver_quality, 10.0);
         assert_eq!(c.finish.fin_distance_over_edge, 0.5);
+        assert_eq!(c.finish.untangle_margin, 1e-6);
+        assert_eq!(
+            (c.finish.zero_set_steps, c.loss.sdf_loss_epsilon),
+            (3, 1e-10)
+        );
+        assert_eq!((c.loss.sdf_loss_weight, c.loss.sdf_loss_start), (0.1, 500));
+        assert_eq!(c.init.sdf_init_resolution, 64);
+        assert_eq!(
+            (c.target.winding_threshold, c.target.scan_max_edge_factor),
+            (0.2, 4.0)
+        );
+        assert_eq!(
+            (
+                c.target.sdf_trace_grid,
+                c.target.sdf_trace_refine_steps,
+                c.target.sdf_projection_steps,
+                c.target.sdf_projection_tolerance
+            ),
+            (128, 8, 5, 1e-5)
+        );
+
+        // The knobs whose pipeline default departs from the library's, as their docs say.
+        assert_eq!(roar_loss::planar::RECONSTRUCTION_PLANAR_SCALE, 500.0);
+        assert_eq!(PlanarOptions::default().scale, 5.0);
+        assert_eq!(TargetOptions::default().views_per_axis, 6);
+        assert_eq!(roar_ops::init::InitOptions::default().resolution, 128);
+        assert_eq!(PointCloudOptions::default().sheet_offset, 0.0);
+        assert_eq!(FaceCollapseOptions::default().min_normal_size, None);
     }
 }

@@ -5,15 +5,17 @@ use roar_ops::decimate::DecimateError;
 use roar_ops::finish::exact_budget::ExactBudgetError;
 use roar_ops::finish::genus::ReduceGenusError;
 use roar_ops::init::InitError;
+use roar_ops::optim::OptimError;
 
+use crate::config::ConfigError;
 use crate::shape::ShapeError;
 
 /// Why a reconstruction failed.
 #[derive(Debug, thiserror::Error)]
 pub enum PipelineError {
-    /// The configuration is unusable.
+    /// The configuration is unusable, or its face budget too small for the init's pieces.
     #[error("config: {0}")]
-    Config(String),
+    Config(#[from] ConfigError),
     /// Target preparation or a loss failed.
     #[error("{0}")]
     Loss(#[from] LossError),
@@ -23,9 +25,18 @@ pub enum PipelineError {
     /// The input shape could not give what the pipeline asked for.
     #[error("{0}")]
     Shape(#[from] ShapeError),
-    /// A mesh that must be a closed manifold is not (a bug in an operator).
+    /// The optimizer refused a step or its options mid-run (a bug: the pipeline keeps its rows
+    /// and inputs in step with the mesh).
     #[error("internal: {0}")]
-    Internal(String),
+    Optimizer(#[from] OptimError),
+    /// The final QEM returned without error but off the budget (a bug).
+    #[error("internal: the output has {faces} faces instead of {budget}")]
+    MissedBudget {
+        /// Faces of the output.
+        faces: usize,
+        /// The budget asked for.
+        budget: usize,
+    },
     /// The final QEM could not reach the budget.
     #[error("{0}")]
     Budget(#[from] DecimateError),
@@ -46,7 +57,9 @@ impl From<ExactBudgetError> for PipelineError {
             ExactBudgetError::Decimate(error) => PipelineError::Budget(error),
             ExactBudgetError::Genus(error) => PipelineError::Genus(error),
             ExactBudgetError::Intersections(faces) => PipelineError::Intersections(faces),
-            ExactBudgetError::Missed { .. } => PipelineError::Internal(error.to_string()),
+            ExactBudgetError::Missed { faces, budget } => {
+                PipelineError::MissedBudget { faces, budget }
+            }
         }
     }
 }

@@ -65,7 +65,8 @@ pub mod shapes;
 mod stages;
 
 pub use config::{
-    FinishConfig, InitConfig, InitKind, LossConfig, OptimizeConfig, ReconstructConfig, TargetConfig,
+    ConfigError, FinishConfig, InitConfig, InitKind, LossConfig, OptimizeConfig, ReconstructConfig,
+    TargetConfig,
 };
 pub use error::PipelineError;
 pub use objective::{LossFactory, Prepared, default_loss, planar_options};

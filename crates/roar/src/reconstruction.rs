@@ -78,7 +78,7 @@ impl Reconstruction {
         progress: &mut dyn FnMut(&Progress),
     ) -> Result<Output, PipelineError> {
         let config = self.config.clone();
-        config.validate().map_err(PipelineError::Config)?;
+        config.validate()?;
         let mut run = Run {
             config: &config,
             stats: RunStats::default(),

@@ -20,6 +20,7 @@ fn with(key: &str, value: toml::Value) -> Result<ReconstructConfig, String> {
         }
     }
     ReconstructConfig::from_toml(&toml::to_string(&table).unwrap(), &defaults)
+        .map_err(|e| e.to_string())
 }
 
 /// Every scalar of the config's TOML layout by its dotted name (`loss.render_weight`).
@@ -100,7 +101,10 @@ fn every_numeric_field_refuses_values_outside_its_range() {
                 assert!(message.contains(leaf), "{}: {message}", range.name);
                 continue;
             }
-            match (parsed.unwrap().validate(), expected_ok) {
+            match (
+                parsed.unwrap().validate().map_err(|e| e.to_string()),
+                expected_ok,
+            ) {
                 (Ok(()), true) => {}
                 (Err(message), true) => {
                     // Allowed by its own range, but in conflict with another field's rule.
@@ -125,17 +129,23 @@ fn every_numeric_field_refuses_values_outside_its_range() {
 fn range_errors_name_field_value_and_range() {
     let config = with("loss.render_weight", toml::Value::Float(f64::NAN)).unwrap();
     assert_eq!(
-        config.validate().unwrap_err(),
+        config.validate().unwrap_err().to_string(),
         "loss.render_weight = NaN is out of range: allowed 0 to 1000000"
     );
     let config = with("finish.sliver_quality", toml::Value::Float(0.5)).unwrap();
-    assert!(config.validate().unwrap_err().contains("0 (off) or 1 to"));
+    assert!(
+        config
+            .validate()
+            .unwrap_err()
+            .to_string()
+            .contains("0 (off) or 1 to")
+    );
 }
 
 #[test]
 fn working_budget_bounds_must_be_ordered() {
     let config = with("optimize.working_budget_min", toml::Value::Integer(30_000)).unwrap();
-    let message = config.validate().unwrap_err();
+    let message = config.validate().unwrap_err().to_string();
     assert!(message.contains(
         "optimize.working_budget_min = 30000 is above optimize.working_budget_max = 20000"
     ));

@@ -44,7 +44,8 @@ fn the_config_parser_survives_mutated_seeds() {
         }));
         match outcome {
             Ok(Ok(Ok(()))) => valid += 1,
-            Ok(Ok(Err(message))) => {
+            Ok(Ok(Err(error))) => {
+                let message = error.to_string();
                 assert_eq!(message.lines().count(), 1, "{message}");
                 refused_by_range += 1;
             }

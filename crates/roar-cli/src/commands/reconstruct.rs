@@ -165,9 +165,7 @@ pub fn run(args: &ReconstructArgs) -> anyhow::Result<()> {
         .as_ref()
         .context("an INPUT file is required (or --print-config)")?;
     let output = args.output.as_ref().context("-o OUTPUT is required")?;
-    config
-        .validate()
-        .map_err(|e| anyhow::anyhow!("config: {e}"))?;
+    config.validate().context("config")?;
     if let Some(preview) = &args.preview {
         let png = preview
             .extension()
@@ -434,8 +432,7 @@ pub fn read_config(
     };
     let text =
         std::fs::read_to_string(path).with_context(|| format!("cannot read {}", path.display()))?;
-    ReconstructConfig::from_toml(&text, &defaults)
-        .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))
+    ReconstructConfig::from_toml(&text, &defaults).with_context(|| path.display().to_string())
 }
 
 /// Defaults, then the TOML file, then the flags.

@@ -4,6 +4,7 @@
 
 use std::path::PathBuf;
 
+use anyhow::Context;
 use clap::Args;
 
 use crate::checks::check_paths;
@@ -42,9 +43,7 @@ pub fn run(args: &ScansArgs) -> anyhow::Result<()> {
         args.config.as_deref(),
         ReconstructConfig::scan_defaults(),
     )?;
-    config
-        .validate()
-        .map_err(|e| anyhow::anyhow!("config: {e}"))?;
+    config.validate().context("config")?;
     anyhow::ensure!(
         roar_io::is_scan_set(&args.input),
         "{}: not a scan set (name a .conf file or the folder holding one)",

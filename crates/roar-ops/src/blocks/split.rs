@@ -36,13 +36,17 @@ use roar_mesh::spatial::{
 use roar_mesh::{DEGENERATE_CROSS, DVec3, EdgeId, FaceId, Mesh, TrackedMesh};
 use std::cell::RefCell;
 
+/// The curvature threshold of the face score, per sub-triangle: the default of
+/// [`SplitThreshold`] and of `roar reconstruct`'s `[optimize] split_threshold`.
+pub const DEFAULT_SPLIT_THRESHOLD: f64 = 0.02;
+
 /// Where the 0.02 curvature threshold of the face score applies
 /// (`docs/method.md#decision-face-score-threshold`). Some threshold is needed either way: with 0,
 /// rounding noise makes flat faces score.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum SplitThreshold {
     /// A sub-triangle whose fold is below the value counts 0 (the authors' scoring code).
-    /// Default 0.02.
+    /// Default [`DEFAULT_SPLIT_THRESHOLD`].
     PerSubTriangle(f64),
     /// Sub-triangles count whatever their fold; a face whose total is below the value scores
     /// 0 (the supplementary's threshold read per face).
@@ -51,7 +55,7 @@ pub enum SplitThreshold {
 
 impl Default for SplitThreshold {
     fn default() -> Self {
-        SplitThreshold::PerSubTriangle(0.02)
+        SplitThreshold::PerSubTriangle(DEFAULT_SPLIT_THRESHOLD)
     }
 }
 

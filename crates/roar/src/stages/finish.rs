@@ -316,9 +316,7 @@ fn polish(
         for k in 0..steps {
             let mut options = *optimizer.options();
             options.lr = config.optimize.learning_rate * (steps - k) as f64 / steps as f64;
-            optimizer
-                .set_options(options)
-                .map_err(|e| PipelineError::Internal(e.to_string()))?;
+            optimizer.set_options(options)?;
             let before = current.clone();
             let record = move_vertices(
                 &mut current,

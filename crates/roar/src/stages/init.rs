@@ -6,7 +6,7 @@ use roar_mesh::Mesh;
 use roar_ops::decimate::{DecimateOptions, decimate};
 
 use crate::budget::{check_budget, smallest_budget};
-use crate::config::{InitKind, ReconstructConfig};
+use crate::config::{ConfigError, InitKind, ReconstructConfig};
 use crate::error::PipelineError;
 use crate::report::RunStats;
 use crate::run::Run;
@@ -22,7 +22,7 @@ pub(crate) fn init(shape: &dyn Shape, run: &mut Run) -> Result<(Mesh, PointCloud
         config.faces,
         smallest_budget(&mesh.component_genera(), config.finish.keep_topology),
     )
-    .map_err(|e| PipelineError::Config(format!("{e} (for the pieces of the init)")))?;
+    .map_err(ConfigError::BudgetForInit)?;
     run.clock.lap("init");
 
     run.report("point_cloud", 0, f64::NAN, mesh.n_faces())?;

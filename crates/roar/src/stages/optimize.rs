@@ -12,7 +12,7 @@ use roar_ops::optim::{Optimizer, OptimizerOptions};
 use roar_ops::untangle::{LimiterOptions, limit_steps};
 use roar_render::{Camera, Image};
 
-use crate::config::ReconstructConfig;
+use crate::config::{ConfigError, ReconstructConfig};
 use crate::error::PipelineError;
 use crate::objective::{LossFactory, Prepared};
 use crate::report::{IterationRecord, RunStats};
@@ -225,7 +225,7 @@ pub(crate) fn new_optimizer(
             ..OptimizerOptions::default()
         },
     )
-    .map_err(|e| PipelineError::Config(e.to_string()))
+    .map_err(|e| ConfigError::Optimizer(e).into())
 }
 
 /// One Move Vertices step (paper §3.1): the loss and its gradient on the compacted mesh, the
@@ -252,9 +252,7 @@ pub(crate) fn move_vertices(
         .optimize
         .step_limiter
         .then(|| mesh.positions().to_vec());
-    optimizer
-        .step(mesh.positions_mut(), &triangles, &gradient)
-        .map_err(|e| PipelineError::Internal(e.to_string()))?;
+    optimizer.step(mesh.positions_mut(), &triangles, &gradient)?;
     clock.lap(&format!("{stage}_step"));
     if let Some(before) = before {
         let limited = limit_steps(
