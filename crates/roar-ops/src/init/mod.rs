@@ -20,11 +20,17 @@
 //!    documents the rule that keeps opposite sides of thin parts ≥ `min_gap` voxels apart);
 //! 5. split into pieces and drop pieces under 0.1 % of the total area.
 //!
+//! When the solid has more pieces than [`InitOptions::target_pieces`] (a small face budget cannot
+//! shape thousands of leaves), nearby pieces are merged between steps 2 and 3 by closing the
+//! solid with the smallest ball that brings the count down (module `merge`); pieces beyond
+//! [`InitOptions::max_pieces`] are dropped at step 5, smallest first.
+//!
 //! [`sdf_init`] builds the same kind of mesh from the negative cells of a signed distance function
 //! (spec §4.3), through the same repair and extraction code.
 
 mod grid;
 mod initial;
+mod merge;
 mod pieces;
 mod project;
 mod sight;
@@ -92,6 +98,16 @@ pub struct InitOptions {
     /// enclosure rule on, exterior voxels hidden from every one of them by the surface it
     /// measured turn solid too (module `sight`). Empty for soups.
     pub scanner_views: Vec<ScannerView>,
+    /// The most pieces the init aims for: with more, nearby pieces are merged by closing the
+    /// solid (dilating, then eroding, by a ball) with the smallest radius, up to
+    /// `max_merge_radius`, that leaves at most this many; pieces too far apart to merge stay.
+    /// `usize::MAX` (the default) never merges.
+    pub target_pieces: usize,
+    /// Largest radius, in voxels, of the closing that merges pieces for `target_pieces`.
+    pub max_merge_radius: usize,
+    /// The most pieces the result may have: beyond it the smallest are dropped (after any
+    /// merging). `usize::MAX` (the default) drops none. At least 1.
+    pub max_pieces: usize,
 }
 
 impl Default for InitOptions {
@@ -113,9 +129,15 @@ impl Default for InitOptions {
             enclosure_winding_threshold: Some(ENCLOSURE_WINDING_THRESHOLD),
             enclosure_max_cap_fraction: ENCLOSURE_MAX_CAP_FRACTION,
             scanner_views: Vec::new(),
+            target_pieces: usize::MAX,
+            max_merge_radius: MAX_MERGE_RADIUS,
+            max_pieces: usize::MAX,
         }
     }
 }
+
+/// The default of [`InitOptions::max_merge_radius`].
+pub const MAX_MERGE_RADIUS: usize = 32;
 
 /// The default of [`InitOptions::enclosure_winding_threshold`], measured (module
 /// `winding_solid`).
@@ -186,10 +208,18 @@ pub struct InitStats {
     pub max_distance_to_target: f64,
     /// Pieces in the output.
     pub pieces: usize,
-    /// Pieces dropped for being under the area threshold.
+    /// Pieces dropped for being under the area threshold or beyond
+    /// [`InitOptions::max_pieces`].
     pub dropped_pieces: usize,
     /// Total area of the dropped pieces.
     pub dropped_area: f64,
+    /// Pieces of the solid before merging, counted on the voxels (26-connected, over the area
+    /// threshold); 0 when [`InitOptions::target_pieces`] is off.
+    pub pieces_before_merge: usize,
+    /// Radius in voxels of the closing that merged pieces (0: none).
+    pub merge_radius: usize,
+    /// Pieces dropped, smallest first, to stay within [`InitOptions::max_pieces`].
+    pub pieces_over_limit: usize,
 }
 
 /// A closed, outward-oriented, 2-manifold triangle mesh and how it was made.
@@ -418,6 +448,9 @@ fn check_options(options: &InitOptions) -> Result<(), InitError> {
     if !(0.0..=1.0).contains(&options.enclosure_max_cap_fraction) {
         return bad("enclosure_max_cap_fraction must be in [0, 1]");
     }
+    if options.target_pieces == 0 || options.max_pieces == 0 {
+        return bad("target_pieces and max_pieces must be at least 1");
+    }
     Ok(())
 }
 
@@ -461,6 +494,17 @@ fn watertight_init_from(
         fill_enclosed(&mut state);
         state
     };
+    let merged = if options.target_pieces < usize::MAX {
+        merge::merge_pieces(
+            &grid,
+            &mut state,
+            options.target_pieces,
+            options.max_merge_radius,
+            options.min_piece_area_fraction,
+        )
+    } else {
+        merge::Merge::default()
+    };
     let repair = solid::repair_nonmanifold(&grid, &mut state, options.max_repair_passes).ok_or(
         InitError::RepairDidNotConverge {
             passes: options.max_repair_passes,
@@ -481,6 +525,7 @@ fn watertight_init_from(
         &surface.positions,
         &surface.triangles,
         options.min_piece_area_fraction,
+        options.max_pieces,
     );
     if pieces.triangles.is_empty() {
         return Err(InitError::EmptyResult);
@@ -504,6 +549,9 @@ fn watertight_init_from(
         pieces: pieces.kept,
         dropped_pieces: pieces.dropped,
         dropped_area: pieces.dropped_area,
+        pieces_before_merge: merged.pieces_before,
+        merge_radius: merged.radius,
+        pieces_over_limit: pieces.over_limit,
     };
     Ok(WatertightInit {
         positions: pieces.positions,
@@ -563,6 +611,7 @@ pub fn sdf_init(
         &surface.positions,
         &surface.triangles,
         options.min_piece_area_fraction,
+        usize::MAX,
     );
     if pieces.triangles.is_empty() {
         return Err(InitError::EmptyResult);
