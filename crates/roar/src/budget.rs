@@ -18,6 +18,25 @@ pub fn smallest_budget(genera: &[usize], keep_topology: bool) -> usize {
     }
 }
 
+/// Faces a merged piece is given on average: when an input has more separate parts than
+/// `faces / FACES_PER_PIECE`, the init merges nearby ones until the pieces fit
+/// ([`pieces_to_aim_for`]), so each can keep a recognisable shape rather than be a tetrahedron.
+pub const FACES_PER_PIECE: usize = 40;
+
+/// The most pieces the init aims for at a budget of `faces` faces (at least 1): more are merged
+/// by proximity (`roar_ops::init::InitOptions::target_pieces`).
+pub fn pieces_to_aim_for(faces: usize) -> usize {
+    (faces / FACES_PER_PIECE).max(1)
+}
+
+/// The most pieces any mesh of `faces` faces can have when handles may be removed (a
+/// tetrahedron each; at least 1): the init drops the smallest pieces beyond it, so a budget that
+/// is even and at least 4 is never refused for the pieces of the init
+/// (`roar_ops::init::InitOptions::max_pieces`).
+pub fn most_pieces(faces: usize) -> usize {
+    (faces / roar_ops::finish::genus::min_reachable_budget(1)).max(1)
+}
+
 /// A face budget no mesh of the pieces at hand can have. Its message names only budgets that
 /// work: the nearest even counts at or above `minimum`.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]

@@ -50,6 +50,14 @@ pub struct InitReport {
     /// Regions the winding-number rule left open, their cap too wide for a puncture
     /// (`roar_ops::init::InitOptions::enclosure_max_cap_fraction`).
     pub init_enclosures_left_open: usize,
+    /// Pieces of the init's solid, counted on its voxels before nearby ones were merged for the
+    /// face budget (`roar::budget::pieces_to_aim_for`; 0 for inits that do not count them).
+    pub init_pieces_before_merge: usize,
+    /// Radius, in voxels, of the closing that merged them (0: none).
+    pub init_merge_radius_voxels: usize,
+    /// Pieces dropped, smallest first, because even merged they were too many for the budget
+    /// (`roar::budget::most_pieces`).
+    pub init_pieces_dropped_for_budget: usize,
 }
 
 /// The loop at the working budget (the `[optimize]` stage).

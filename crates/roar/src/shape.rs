@@ -51,6 +51,20 @@ pub struct InitialMesh {
     /// Regions the enclosure rule left open, their cap being too wide for a puncture (an open
     /// surface's opening); 0 for other kinds of init. For reports.
     pub enclosures_left_open: usize,
+    /// How the init merged or dropped pieces to fit the face budget (zeros when it did not).
+    pub merged: PieceMerge,
+}
+
+/// How an init brought more separate parts than the face budget can shape down to fewer pieces,
+/// for reports.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct PieceMerge {
+    /// Pieces before merging (0 when the init does not count them).
+    pub pieces_before: usize,
+    /// Radius, in voxels, of the closing that merged nearby pieces (0: none).
+    pub radius_voxels: usize,
+    /// Pieces dropped, smallest first, because even merged they were too many for the budget.
+    pub pieces_dropped: usize,
 }
 
 /// Figures about a shape's own preparation, for reports (zeros where a kind has no such thing).

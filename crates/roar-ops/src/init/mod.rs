@@ -21,12 +21,18 @@
 //!    documents the rule that keeps opposite sides of thin parts ≥ `min_gap` voxels apart);
 //! 5. split into pieces and drop pieces under 0.1 % of the total area.
 //!
+//! When the solid has more pieces than [`InitOptions::target_pieces`] (a small face budget cannot
+//! shape thousands of leaves), nearby pieces are merged between steps 2 and 3 by closing the
+//! solid with the smallest ball that brings the count down (module `merge`); pieces beyond
+//! [`InitOptions::max_pieces`] are dropped at step 5, smallest first.
+//!
 //! [`sdf_init`] builds the same kind of mesh from the negative cells of a signed distance function
 //! (supplementary §3), through the same repair and extraction code.
 
 mod error;
 mod grid;
 mod initial;
+mod merge;
 mod options;
 mod output;
 mod pieces;
@@ -44,7 +50,8 @@ mod winding_solid;
 pub use error::InitError;
 pub use initial::{InitialMeshOptions, InitialMeshStats, initial_mesh, initial_mesh_from_init};
 pub use options::{
-    ENCLOSURE_MAX_CAP_FRACTION, ENCLOSURE_WINDING_THRESHOLD, InitOptions, SdfInitOptions,
+    ENCLOSURE_MAX_CAP_FRACTION, ENCLOSURE_WINDING_THRESHOLD, InitOptions, MAX_MERGE_RADIUS,
+    SdfInitOptions,
 };
 pub use output::{InitStats, WatertightInit};
 pub use sdf::sdf_init;

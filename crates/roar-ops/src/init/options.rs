@@ -52,6 +52,16 @@ pub struct InitOptions {
     /// enclosure rule on, exterior voxels hidden from every one of them by the surface it
     /// measured turn solid too (module `sight`). Empty for soups.
     pub scanner_views: Vec<ScannerView>,
+    /// The most pieces the init aims for: with more, nearby pieces are merged by closing the
+    /// solid (dilating, then eroding, by a ball) with the smallest radius, up to
+    /// `max_merge_radius`, that leaves at most this many; pieces too far apart to merge stay.
+    /// `usize::MAX` (the default) never merges.
+    pub target_pieces: usize,
+    /// Largest radius, in voxels, of the closing that merges pieces for `target_pieces`.
+    pub max_merge_radius: usize,
+    /// The most pieces the result may have: beyond it the smallest are dropped (after any
+    /// merging). `usize::MAX` (the default) drops none. At least 1.
+    pub max_pieces: usize,
 }
 
 impl Default for InitOptions {
@@ -73,9 +83,15 @@ impl Default for InitOptions {
             enclosure_winding_threshold: Some(ENCLOSURE_WINDING_THRESHOLD),
             enclosure_max_cap_fraction: ENCLOSURE_MAX_CAP_FRACTION,
             scanner_views: Vec::new(),
+            target_pieces: usize::MAX,
+            max_merge_radius: MAX_MERGE_RADIUS,
+            max_pieces: usize::MAX,
         }
     }
 }
+
+/// The default of [`InitOptions::max_merge_radius`].
+pub const MAX_MERGE_RADIUS: usize = 32;
 
 /// The default of [`InitOptions::enclosure_winding_threshold`], measured (module
 /// `winding_solid`).

@@ -45,6 +45,13 @@ pub struct InitStats {
     pub dropped_pieces: usize,
     /// Total area of the dropped pieces.
     pub dropped_area: f64,
+    /// Pieces of the solid before merging, counted on the voxels (26-connected, over the area
+    /// threshold); 0 when [`InitOptions::target_pieces`](super::InitOptions::target_pieces) is off.
+    pub pieces_before_merge: usize,
+    /// Radius in voxels of the closing that merged pieces (0: none).
+    pub merge_radius: usize,
+    /// Pieces dropped, smallest first, to stay within [`InitOptions::max_pieces`](super::InitOptions::max_pieces).
+    pub pieces_over_limit: usize,
 }
 
 /// A closed, outward-oriented, 2-manifold triangle mesh and how it was made.

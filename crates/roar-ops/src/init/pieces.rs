@@ -1,5 +1,5 @@
 //! Step 5: connected pieces of the output surface; pieces under a fraction of the total area are
-//! dropped.
+//! dropped, and so are the smallest beyond a largest count.
 
 use glam::DVec3;
 
@@ -18,14 +18,20 @@ pub(crate) struct Pieces {
     pub kept: usize,
     pub dropped: usize,
     pub dropped_area: f64,
+    /// Pieces over the area threshold dropped for being beyond the largest count (included in
+    /// `dropped`).
+    pub over_limit: usize,
 }
 
 /// Splits the mesh into vertex-connected pieces, drops those whose area is below
-/// `min_area_fraction` of the total, and compacts the vertex buffer (vertices keep their order).
+/// `min_area_fraction` of the total, then the smallest until at most `max_pieces` remain (ties:
+/// the piece with the later first vertex goes first), and compacts the vertex buffer (vertices
+/// keep their order).
 pub(crate) fn keep_large_pieces(
     positions: &[DVec3],
     triangles: &[[u32; 3]],
     min_area_fraction: f64,
+    max_pieces: usize,
 ) -> Pieces {
     let mut parent: Vec<u32> = (0..positions.len() as u32).collect();
     for t in triangles {
@@ -62,6 +68,18 @@ pub(crate) fn keep_large_pieces(
             }
         }
     }
+    let mut over_limit = 0;
+    if kept > max_pieces {
+        let mut roots: Vec<usize> = (0..positions.len()).filter(|&v| keep_root[v]).collect();
+        roots.sort_by(|&a, &b| area[b].total_cmp(&area[a]).then(a.cmp(&b)));
+        for &v in &roots[max_pieces..] {
+            keep_root[v] = false;
+            over_limit += 1;
+            dropped_area += area[v];
+        }
+        kept -= over_limit;
+        dropped += over_limit;
+    }
     let mut new_index = vec![u32::MAX; positions.len()];
     let mut out_positions = Vec::new();
     let mut out_triangles = Vec::new();
@@ -83,5 +101,6 @@ pub(crate) fn keep_large_pieces(
         kept,
         dropped,
         dropped_area,
+        over_limit,
     }
 }

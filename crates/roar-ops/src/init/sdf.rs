@@ -60,6 +60,7 @@ pub fn sdf_init(
         &surface.positions,
         &surface.triangles,
         options.min_piece_area_fraction,
+        usize::MAX,
     );
     if pieces.triangles.is_empty() {
         return Err(InitError::EmptyResult);

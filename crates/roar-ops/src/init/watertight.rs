@@ -6,7 +6,7 @@ use super::grid::{Grid, SOLID};
 use super::options::InitOptions;
 use super::output::{InitStats, WatertightInit};
 use super::soup::{soup_bounds, split_long_edges, valid_triangles};
-use super::{pieces, project, solid, surface, voxelize, winding_solid};
+use super::{merge, pieces, project, solid, surface, voxelize, winding_solid};
 use glam::DVec3;
 use roar_mesh::spatial::TriangleBvh;
 
@@ -89,6 +89,9 @@ fn check_options(options: &InitOptions) -> Result<(), InitError> {
     if !(0.0..=1.0).contains(&options.enclosure_max_cap_fraction) {
         return bad("enclosure_max_cap_fraction must be in [0, 1]");
     }
+    if options.target_pieces == 0 || options.max_pieces == 0 {
+        return bad("target_pieces and max_pieces must be at least 1");
+    }
     Ok(())
 }
 
@@ -132,6 +135,17 @@ fn watertight_init_from(
         fill_enclosed(&mut state);
         state
     };
+    let merged = if options.target_pieces < usize::MAX {
+        merge::merge_pieces(
+            &grid,
+            &mut state,
+            options.target_pieces,
+            options.max_merge_radius,
+            options.min_piece_area_fraction,
+        )
+    } else {
+        merge::Merge::default()
+    };
     let repair = solid::repair_nonmanifold(&grid, &mut state, options.max_repair_passes).ok_or(
         InitError::RepairDidNotConverge {
             passes: options.max_repair_passes,
@@ -152,6 +166,7 @@ fn watertight_init_from(
         &surface.positions,
         &surface.triangles,
         options.min_piece_area_fraction,
+        options.max_pieces,
     );
     if pieces.triangles.is_empty() {
         return Err(InitError::EmptyResult);
@@ -175,6 +190,9 @@ fn watertight_init_from(
         pieces: pieces.kept,
         dropped_pieces: pieces.dropped,
         dropped_area: pieces.dropped_area,
+        pieces_before_merge: merged.pieces_before,
+        merge_radius: merged.radius,
+        pieces_over_limit: pieces.over_limit,
     };
     Ok(WatertightInit {
         positions: pieces.positions,

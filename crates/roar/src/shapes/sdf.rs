@@ -231,6 +231,7 @@ impl Shape for SdfShape {
             raw_faces,
             voxels_filled_by_winding: 0,
             enclosures_left_open: 0,
+            merged: Default::default(),
         })
     }
 

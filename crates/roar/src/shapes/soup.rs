@@ -19,9 +19,10 @@ use roar_mesh::spatial::{Aabb, Normalization};
 use roar_ops::init::{InitOptions, InitialMeshOptions, ScannerView};
 use roar_render::{Camera, Image};
 
+use crate::budget::{most_pieces, pieces_to_aim_for};
 use crate::config::ReconstructConfig;
 use crate::rig::target_options;
-use crate::shape::{InitialMesh, Shape, ShapeError, ShapeSummary};
+use crate::shape::{InitialMesh, PieceMerge, Shape, ShapeError, ShapeSummary};
 
 /// A triangle soup (any coordinates, anything goes) and the configuration it is cleaned up,
 /// initialised and sampled with.
@@ -126,6 +127,8 @@ impl Shape for SoupShape<'_> {
                         triangles: view.triangles.clone(),
                     })
                     .collect(),
+                target_pieces: pieces_to_aim_for(self.config.faces),
+                max_pieces: most_pieces(self.config.faces),
                 ..InitOptions::default()
             },
             max_faces: self.config.init.init_max_faces,
@@ -139,6 +142,11 @@ impl Shape for SoupShape<'_> {
             raw_faces: stats.init_faces,
             voxels_filled_by_winding: stats.init.voxels_filled_by_winding,
             enclosures_left_open: stats.init.enclosures_left_open,
+            merged: PieceMerge {
+                pieces_before: stats.init.pieces_before_merge,
+                radius_voxels: stats.init.merge_radius,
+                pieces_dropped: stats.init.pieces_over_limit,
+            },
         })
     }
 
