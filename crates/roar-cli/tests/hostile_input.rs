@@ -372,8 +372,9 @@ fn a_run_writes_its_mesh_and_report_together_and_nothing_else() {
 }
 
 #[test]
-fn a_budget_below_what_the_inits_pieces_need_is_refused_before_the_loop() {
-    // Two cubes far apart: two pieces of genus 0, so at least 8 faces.
+fn a_budget_too_small_for_every_piece_keeps_the_largest_and_says_so() {
+    // Two cubes far apart: two pieces of genus 0 need at least 8 faces. At 6, the init keeps
+    // one piece (too far apart to merge) and the report and the summary say one was dropped.
     let dir = tempfile::tempdir().unwrap();
     let mut text = String::new();
     for (k, dx) in [0.0, 5.0].iter().enumerate() {
@@ -396,6 +397,7 @@ fn a_budget_below_what_the_inits_pieces_need_is_refused_before_the_loop() {
     let cubes = dir.path().join("cubes.obj");
     std::fs::write(&cubes, text).unwrap();
     let out = dir.path().join("out.obj");
+    let report = dir.path().join("report.json");
     let run = roar(&[
         "reconstruct",
         s(&cubes),
@@ -405,11 +407,20 @@ fn a_budget_below_what_the_inits_pieces_need_is_refused_before_the_loop() {
         "6",
         "--iterations",
         "0",
-        "-q",
+        "--report",
+        s(&report),
     ]);
-    assert_refused(
-        &run,
-        "smallest reachable budget, 8 faces; use 8 (for the pieces of the init)",
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
     );
-    assert!(!out.exists());
+    let mesh = roar_io::read_mesh(&out).unwrap();
+    assert_eq!(mesh.triangles.len(), 6);
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
+    assert_eq!(json["run"]["init"]["init_pieces_dropped_for_budget"], 1);
+    assert_eq!(json["output_metrics"]["topology"]["components"], 1);
+    let summary = String::from_utf8_lossy(&run.stdout);
+    assert!(summary.contains("1 piece(s) dropped"), "{summary}");
 }

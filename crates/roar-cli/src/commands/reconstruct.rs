@@ -329,6 +329,12 @@ fn summary(args: &ReconstructArgs, report: &ReconstructReport) -> String {
                 + sdf.evaluations.gradients.values().sum::<u64>()
         );
     }
+    let dropped = report.run.init.init_pieces_dropped_for_budget;
+    if dropped > 0 {
+        text += &format!(
+            "  pieces    {dropped} piece(s) dropped, the smallest: the budget cannot give every part a closed piece\n"
+        );
+    }
     let removed = report.run.finish.handles_removed.len();
     if removed > 0 {
         text += &format!(
