@@ -4,7 +4,7 @@
 Per model and face budget:
 
 - `roar`           through `roar batch OUT/manifest.tsv -o OUT/roar --faces N,…` (resumable:
-                   the batch skips what an earlier run finished with the same build),
+                   the batch skips items already done by the same build),
 - `alphawrap+qem`, `manifold+qem`  scripts/peers.py (the peer once per model, then MeshLab's QEM
                    to every budget), each budget's result recorded in
                    OUT/peers/<method>/<id>/<budget>.json, so a rerun skips it,
@@ -97,7 +97,7 @@ def sha256(path):
 
 
 def kill_group(proc):
-    """Stops `proc` and everything in its process group (it leads the group: its own session):
+    """Stops `proc` and everything in its process group (it was started as the group's leader):
     SIGTERM, then SIGKILL after 5 s. By pid only, never by name."""
     for sig, grace in ((signal.SIGTERM, 5.0), (signal.SIGKILL, 5.0)):
         try:

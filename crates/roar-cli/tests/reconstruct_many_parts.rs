@@ -9,30 +9,18 @@ use roar_mesh::spatial::self_intersecting_faces;
 
 mod common;
 
-/// Unit cubes on an `n[0] × n[1] × n[2]` lattice, `spacing` apart corner to corner.
+/// Unit cubes (`roar_mesh::shapes::cube`) on an `n[0] × n[1] × n[2]` lattice, `spacing` apart
+/// corner to corner.
 fn cubes(n: [usize; 3], spacing: f64) -> (Vec<DVec3>, Vec<[u32; 3]>) {
-    let quads = [
-        [0, 2, 3, 1],
-        [4, 5, 7, 6],
-        [0, 1, 5, 4],
-        [2, 6, 7, 3],
-        [0, 4, 6, 2],
-        [1, 3, 7, 5],
-    ];
+    let (corners, faces) = roar_mesh::shapes::cube().to_triangles();
     let (mut positions, mut triangles) = (Vec::new(), Vec::new());
     for k in 0..n[2] {
         for j in 0..n[1] {
             for i in 0..n[0] {
                 let min = DVec3::new(i as f64, j as f64, k as f64) * spacing;
                 let base = positions.len() as u32;
-                for c in 0..8 {
-                    let corner = DVec3::new((c & 1) as f64, ((c >> 1) & 1) as f64, (c >> 2) as f64);
-                    positions.push(min + corner);
-                }
-                for q in quads {
-                    triangles.push([q[0], q[1], q[2]].map(|v| base + v));
-                    triangles.push([q[0], q[2], q[3]].map(|v| base + v));
-                }
+                positions.extend(corners.iter().map(|&p| min + p + DVec3::splat(0.5)));
+                triangles.extend(faces.iter().map(|t| t.map(|v| base + v)));
             }
         }
     }
@@ -62,7 +50,7 @@ fn reconstruct(soup: &(Vec<DVec3>, Vec<[u32; 3]>), faces: usize) -> (usize, roar
 
 #[test]
 fn three_hundred_cubes_at_500_faces_merge_into_fewer_closed_pieces() {
-    // Without merging, 300 pieces need at least 1200 faces and the budget was refused.
+    // Without merging, 300 pieces need at least 1200 faces so the budget would be refused.
     let (pieces, stats) = reconstruct(&cubes([10, 10, 3], 2.0), 500);
     assert_eq!(stats.init.init_pieces_before_merge, 300);
     assert!(stats.init.init_merge_radius_voxels > 0);
