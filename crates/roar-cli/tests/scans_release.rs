@@ -61,6 +61,7 @@ fn four_bunny_scans_reconstruct_to_a_closed_genus_0_mesh_of_exactly_the_budget()
         let scan = ReconstructConfig::scan_defaults().init;
         config.init.enclosure_winding_threshold = scan.enclosure_winding_threshold;
         config.init.enclosure_max_cap_fraction = scan.enclosure_max_cap_fraction;
+        config.init.enclosure_max_cap_width = scan.enclosure_max_cap_width;
         // The default init grid: the toy one is too coarse for the tunnels to open.
         config.init.init_resolution = scan.init_resolution;
         config

@@ -339,6 +339,7 @@ fn a_cube_scanned_from_two_opposite_sides_is_solid_only_with_the_lines_of_sight(
         resolution: 48,
         enclosure_winding_threshold: Some(0.6),
         enclosure_max_cap_fraction: 1.0,
+        enclosure_max_cap_width: 1.0,
         ..InitOptions::default()
     };
     let volume = |out: &WatertightInit| -> f64 {

@@ -11,10 +11,10 @@ use std::f64::consts::TAU;
 use std::path::PathBuf;
 
 use glam::DVec3;
+use roar::{EnclosureFigures, InitialMesh, Shape, ShapeError};
 use roar::{
     FinishConfig, LossConfig, OptimizeConfig, ReconstructConfig, Reconstruction, TargetConfig,
 };
-use roar::{InitialMesh, Shape, ShapeError};
 use roar_io::TriangleSoup;
 use roar_loss::{PointCloud, render_views};
 use roar_mesh::Mesh;
@@ -75,8 +75,7 @@ impl Shape for AnalyticTorus {
         Ok(InitialMesh {
             mesh,
             raw_faces,
-            voxels_filled_by_winding: 0,
-            enclosures_left_open: 0,
+            enclosure: EnclosureFigures::default(),
             merged: Default::default(),
         })
     }

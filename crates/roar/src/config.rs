@@ -17,7 +17,8 @@ use roar_ops::finish::fins::FinOptions;
 use roar_ops::finish::slivers::SliverOptions;
 use roar_ops::finish::zero_set::ZeroSetOptions;
 use roar_ops::init::{
-    ENCLOSURE_MAX_CAP_FRACTION, ENCLOSURE_WINDING_THRESHOLD, InitialMeshOptions, SdfInitOptions,
+    ENCLOSURE_MAX_CAP_FRACTION, ENCLOSURE_MAX_CAP_WIDTH, ENCLOSURE_WINDING_THRESHOLD,
+    InitialMeshOptions, SdfInitOptions,
 };
 use roar_ops::optim::{OptimError, OptimizerOptions};
 use roar_ops::untangle::UntangleOptions;
@@ -122,13 +123,6 @@ impl RangeValue for usize {
         self as f64
     }
 }
-
-/// The enclosure rule's threshold for scan sets (`init.enclosure_winding_threshold` of
-/// [`ReconstructConfig::scan_defaults`]), below the soups'
-/// `roar_ops::init::ENCLOSURE_WINDING_THRESHOLD` (0.7): scans leave wider openings than soups'
-/// punctures, and at the soups' threshold the init can keep a tunnel through the parts the
-/// scanner never saw (why: `docs/scans.md`).
-pub const SCAN_ENCLOSURE_WINDING_THRESHOLD: f64 = 0.6;
 
 /// How the initial mesh M0 is made.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
@@ -248,9 +242,14 @@ config_table! {
         /// value turn solid, so punctures of a closed surface close while tunnels stay.
         enclosure_winding_threshold: f64 = ENCLOSURE_WINDING_THRESHOLD, zero_or(0.5, 1.0);
         /// A region the enclosure rule fills stays filled only if its widest cap (a patch of its
-        /// boundary no input surface covers) is at most this fraction of its boundary: punctures
-        /// close, the wide opening of an open surface stays open (1 closes every opening).
+        /// boundary no input surface covers) is at most this fraction of its boundary, so open
+        /// containers and the concave side of an open sheet do not fill (1 accepts every
+        /// region).
         enclosure_max_cap_fraction: f64 = ENCLOSURE_MAX_CAP_FRACTION, range(0.0, 1.0);
+        /// ... and only if no point of its caps is farther than this fraction of the input's
+        /// longest side from the input: punctures close, the wide opening of an open box or a
+        /// cup stays open (1 closes every opening).
+        enclosure_max_cap_width: f64 = ENCLOSURE_MAX_CAP_WIDTH, range(0.0, 1.0);
         /// Subdivision level of the sphere init. Finer than the paper's level 2, so that a sphere
         /// can reach detail.
         sphere_level: u32 = 4, range(0.0, 8.0);
@@ -461,16 +460,15 @@ impl ReconstructConfig {
         config
     }
 
-    /// The defaults for a set of range scans: the soup's, with the init's enclosure rule at
-    /// [`SCAN_ENCLOSURE_WINDING_THRESHOLD`] closing every opening,
-    /// however wide, since a scanned object is closed but the scanner never sees all of it (the
+    /// The defaults for a set of range scans: the soup's, with the init's enclosure rule closing
+    /// every opening, however wide, since a scanned object is closed but the scanner never sees all of it (the
     /// bunny's base), every iteration on the full rig, and the loop's stop with the 50-iteration
     /// window and 1 % tolerance and the checkpoints every 10 iterations `docs/scans.md` was
     /// measured with (the soups' 20, 3 % and 5 are measured on soups only).
     pub fn scan_defaults() -> Self {
         let mut config = Self::default();
-        config.init.enclosure_winding_threshold = SCAN_ENCLOSURE_WINDING_THRESHOLD;
         config.init.enclosure_max_cap_fraction = 1.0;
+        config.init.enclosure_max_cap_width = 1.0;
         config.keep_the_full_rig();
         config.optimize.checkpoint_interval = 10;
         config.optimize.level_window = 50;
@@ -841,9 +839,10 @@ mod tests {
         assert_eq!(c.init.kind, InitKind::Watertight);
         assert_eq!(c.init.init_resolution, 192);
         assert_eq!(c.init.init_max_faces, 20_000);
-        assert_eq!(c.init.enclosure_winding_threshold, 0.7);
+        assert_eq!(c.init.enclosure_winding_threshold, 0.5);
         assert_eq!(c.init.enclosure_max_cap_fraction, 0.02);
-        assert_eq!(roar_ops::init::ENCLOSURE_WINDING_THRESHOLD, 0.7);
+        assert_eq!(c.init.enclosure_max_cap_width, 0.25);
+        assert_eq!(roar_ops::init::ENCLOSURE_WINDING_THRESHOLD, 0.5);
         assert_eq!(c.init.sphere_level, 4);
         assert_eq!(
             (

@@ -77,7 +77,7 @@ pub use report::{
 pub use rig::{coarse_rig_cameras, rig_cameras, target_options};
 pub use run::Progress;
 pub use schedule::{ScheduledBlock, default_blocks};
-pub use shape::{InitialMesh, PieceMerge, Shape, ShapeError, ShapeSummary};
+pub use shape::{EnclosureFigures, InitialMesh, PieceMerge, Shape, ShapeError, ShapeSummary};
 pub use shapes::scans::{AlignedScans, ScanReport, load_scans};
 pub use shapes::sdf::SdfShape;
 pub use shapes::soup::SoupShape;

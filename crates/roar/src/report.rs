@@ -50,6 +50,11 @@ pub struct InitReport {
     /// Regions the winding-number rule left open, their cap too wide for a puncture
     /// (`roar_ops::init::InitOptions::enclosure_max_cap_fraction`).
     pub init_enclosures_left_open: usize,
+    /// Patches of the soup (faces joined across two-face edges) the enclosure rule oriented,
+    /// each to face the side it is seen from, before taking the winding number.
+    pub init_winding_patches: usize,
+    /// Of those, the patches it turned over.
+    pub init_winding_patches_flipped: usize,
     /// Pieces of the init's solid, counted on its voxels before nearby ones were merged for the
     /// face budget (`roar::budget::pieces_to_aim_for`; 0 for inits that do not count them).
     pub init_pieces_before_merge: usize,

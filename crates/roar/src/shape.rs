@@ -45,14 +45,25 @@ pub struct InitialMesh {
     /// Faces of the shape's raw init before it was decimated (the voxel surface of a soup's
     /// watertight init; `mesh.n_faces()` when nothing was decimated). For reports.
     pub raw_faces: usize,
-    /// Voxels of a soup's watertight init that the enclosure rule (generalized winding number)
-    /// made solid; 0 for other kinds of init. For reports.
-    pub voxels_filled_by_winding: usize,
-    /// Regions the enclosure rule left open, their cap being too wide for a puncture (an open
-    /// surface's opening); 0 for other kinds of init. For reports.
-    pub enclosures_left_open: usize,
+    /// What the enclosure rule of a soup's watertight init did (zeros for other kinds of init).
+    pub enclosure: EnclosureFigures,
     /// How the init merged or dropped pieces to fit the face budget (zeros when it did not).
     pub merged: PieceMerge,
+}
+
+/// What the enclosure rule (generalized winding number) of a soup's watertight init did, for
+/// reports.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct EnclosureFigures {
+    /// Voxels the rule made solid (punctures closed).
+    pub voxels_filled: usize,
+    /// Regions the rule left open, their cap being too wide for a puncture (an open surface's
+    /// opening).
+    pub left_open: usize,
+    /// Patches of the soup (faces joined across two-face edges) oriented for the winding number.
+    pub patches: usize,
+    /// Of those, the patches turned over because their back was seen more than their front.
+    pub patches_flipped: usize,
 }
 
 /// How an init brought more separate parts than the face budget can shape down to fewer pieces,

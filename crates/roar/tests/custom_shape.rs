@@ -9,8 +9,8 @@ use std::sync::Arc;
 
 use glam::DVec3;
 use roar::{
-    FinishConfig, InitialMesh, LossConfig, OptimizeConfig, Prepared, ReconstructConfig,
-    Reconstruction, Shape, ShapeError, ShapeSummary, TargetConfig, default_loss,
+    EnclosureFigures, FinishConfig, InitialMesh, LossConfig, OptimizeConfig, Prepared,
+    ReconstructConfig, Reconstruction, Shape, ShapeError, ShapeSummary, TargetConfig, default_loss,
 };
 use roar_loss::{PointCloud, Sdf, SdfEvaluations, render_views};
 use roar_mesh::Mesh;
@@ -105,8 +105,7 @@ impl Shape for AnalyticSphere {
         Ok(InitialMesh {
             mesh,
             raw_faces,
-            voxels_filled_by_winding: 0,
-            enclosures_left_open: 0,
+            enclosure: EnclosureFigures::default(),
             merged: Default::default(),
         })
     }

@@ -34,6 +34,7 @@ mod grid;
 mod initial;
 mod merge;
 mod options;
+mod orient;
 mod output;
 mod pieces;
 mod project;
@@ -50,8 +51,8 @@ mod winding_solid;
 pub use error::InitError;
 pub use initial::{InitialMeshOptions, InitialMeshStats, initial_mesh, initial_mesh_from_init};
 pub use options::{
-    ENCLOSURE_MAX_CAP_FRACTION, ENCLOSURE_WINDING_THRESHOLD, InitOptions, MAX_MERGE_RADIUS,
-    SdfInitOptions,
+    ENCLOSURE_MAX_CAP_FRACTION, ENCLOSURE_MAX_CAP_WIDTH, ENCLOSURE_WINDING_THRESHOLD, InitOptions,
+    MAX_MERGE_RADIUS, SdfInitOptions,
 };
 pub use output::{InitStats, WatertightInit};
 pub use sdf::sdf_init;

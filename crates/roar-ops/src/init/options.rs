@@ -45,9 +45,15 @@ pub struct InitOptions {
     pub enclosure_winding_threshold: Option<f64>,
     /// A region the enclosure rule fills is kept only if its widest cap (the largest connected
     /// patch of its boundary that no input surface covers) is at most this fraction of its whole
-    /// boundary, so punctures close and wide openings (a head open at the neck) stay open.
-    /// Default [`ENCLOSURE_MAX_CAP_FRACTION`]; 1 accepts every region. In `[0, 1]`.
+    /// boundary, so open containers (a tub, a head open at the neck) and the concave side of an
+    /// open sheet (a leaf) do not fill. Default
+    /// [`ENCLOSURE_MAX_CAP_FRACTION`]; 1 accepts every region. In `[0, 1]`.
     pub enclosure_max_cap_fraction: f64,
+    /// ... and only if no point of its caps is farther than this fraction of the bounding box's
+    /// longest side from the input's shell (a cap's inradius), so holes close and wide openings
+    /// (an open box, a cup) stay open. Default [`ENCLOSURE_MAX_CAP_WIDTH`]; 1 accepts every
+    /// region. In `[0, 1]`.
+    pub enclosure_max_cap_width: f64,
     /// The scanners a set of range scans was measured from, in the soup's coordinates: with the
     /// enclosure rule on, exterior voxels hidden from every one of them by the surface it
     /// measured turn solid too (module `sight`). Empty for soups.
@@ -82,6 +88,7 @@ impl Default for InitOptions {
             max_repair_passes: 64,
             enclosure_winding_threshold: Some(ENCLOSURE_WINDING_THRESHOLD),
             enclosure_max_cap_fraction: ENCLOSURE_MAX_CAP_FRACTION,
+            enclosure_max_cap_width: ENCLOSURE_MAX_CAP_WIDTH,
             scanner_views: Vec::new(),
             target_pieces: usize::MAX,
             max_merge_radius: MAX_MERGE_RADIUS,
@@ -93,14 +100,17 @@ impl Default for InitOptions {
 /// The default of [`InitOptions::max_merge_radius`].
 pub const MAX_MERGE_RADIUS: usize = 32;
 
-/// The default of [`InitOptions::enclosure_winding_threshold`], measured (module
-/// `winding_solid`).
-pub const ENCLOSURE_WINDING_THRESHOLD: f64 = 0.7;
+/// The default of [`InitOptions::enclosure_winding_threshold`]: ½, the level set of the
+/// generalized winding number that separates inside from outside (Jacobson et al. 2013).
+pub const ENCLOSURE_WINDING_THRESHOLD: f64 = 0.5;
 
-/// The default of [`InitOptions::enclosure_max_cap_fraction`]: the widest cap is at most 0.5 %
-/// of the filled region's boundary on the punctured inputs measured (clean/bunny.obj's open
-/// base, gpytoolbox-airplane's gaps) and 7 % on an open surface (libigl-camelhead's neck).
+/// The default of [`InitOptions::enclosure_max_cap_fraction`], measured on the wild meshes'
+/// punctures and open containers (docs/method.md#punctures-close-while-tunnels-and-openings-stay).
 pub const ENCLOSURE_MAX_CAP_FRACTION: f64 = 0.02;
+
+/// The default of [`InitOptions::enclosure_max_cap_width`], measured with
+/// `scripts/punctured.py` (docs/method.md#punctures-close-while-tunnels-and-openings-stay).
+pub const ENCLOSURE_MAX_CAP_WIDTH: f64 = 0.25;
 
 /// Options of [`sdf_init`](super::sdf_init) (supplementary §3: a 64³ grid over the bounding cube).
 #[derive(Clone, Debug, PartialEq)]

@@ -33,6 +33,11 @@ pub struct InitStats {
     /// Regions the winding-number rule would have filled but left open, their cap being too wide
     /// (see [`InitOptions::enclosure_max_cap_fraction`](super::InitOptions::enclosure_max_cap_fraction)).
     pub enclosures_left_open: usize,
+    /// Patches of the soup (faces joined across two-face edges) the enclosure rule oriented
+    /// before taking the winding number (0 when the rule is off).
+    pub winding_patches: usize,
+    /// Of those, the patches turned over because their back was seen more than their front.
+    pub winding_patches_flipped: usize,
     /// Projection moves rejected by the fold guard.
     pub rejected_moves: usize,
     /// Mean distance from output vertices to the target (world units; 0 for the SDF init).

@@ -42,6 +42,7 @@ const OFFSETS: [[i32; 3]; 26] = {
 /// centre.
 struct Tables {
     adj6: [u32; 26],
+    adj26: [u32; 26],
     n18: u32,
     n6: u32,
 }
@@ -49,6 +50,7 @@ struct Tables {
 const TABLES: Tables = {
     let mut t = Tables {
         adj6: [0; 26],
+        adj26: [0; 26],
         n18: 0,
         n6: 0,
     };
@@ -68,6 +70,11 @@ const TABLES: Tables = {
             let d = (a[0] - b[0]).abs() + (a[1] - b[1]).abs() + (a[2] - b[2]).abs();
             if d == 1 {
                 t.adj6[i] |= 1 << j;
+            }
+            let touching =
+                (a[0] - b[0]).abs() <= 1 && (a[1] - b[1]).abs() <= 1 && (a[2] - b[2]).abs() <= 1;
+            if i != j && touching {
+                t.adj26[i] |= 1 << j;
             }
             j += 1;
         }
@@ -101,6 +108,15 @@ fn groups(set: u32, adj: &[u32; 26], seeds: u32) -> u32 {
 /// [`offsets`]): the number of exterior groups it would join (module docs).
 pub(crate) fn exterior_groups(exterior: u32) -> u32 {
     groups(exterior & TABLES.n18, &TABLES.adj6, TABLES.n6)
+}
+
+/// Whether a solid voxel whose exterior neighbours are `exterior` may turn exterior without
+/// changing the topology of the solid or of the exterior (Bertrand & Malandain: `T6 = 1` for the
+/// 6-connected exterior and `T26 ≤ 1` for the 26-connected solid; `T26 = 0` is a lone voxel,
+/// whose removal only drops itself). Cuts no tunnel, opens no cavity, breaks no bridge.
+pub(crate) fn is_simple(exterior: u32) -> bool {
+    const ALL: u32 = (1 << 26) - 1;
+    exterior_groups(exterior) == 1 && groups(!exterior & ALL, &TABLES.adj26, ALL) <= 1
 }
 
 /// The 26 neighbour offsets (bit order of the masks [`is_simple`] takes).
@@ -138,6 +154,20 @@ mod tests {
         // A solid rod along x: everything around it is exterior, so cutting it is allowed (it
         // removes a handle or separates two parts), unlike cutting a wall.
         assert_eq!(exterior_groups(mask(|o| o[1] != 0 || o[2] != 0)), 1);
+    }
+
+    #[test]
+    fn a_simple_voxel_moves_the_boundary_and_nothing_else() {
+        // Under a flat exterior, with solid below: simple.
+        assert!(is_simple(mask(|o| o[2] == 1)));
+        // In a wall between two exterior layers: opening it cuts a tunnel.
+        assert!(!is_simple(mask(|o| o[2] != 0)));
+        // The middle of a thin rod: opening it breaks the rod in two.
+        assert!(!is_simple(mask(|o| o[1] != 0 || o[2] != 0)));
+        // Buried: opening it starts a cavity.
+        assert!(!is_simple(0));
+        // Alone in the exterior: opening it only drops itself.
+        assert!(is_simple((1 << 26) - 1));
     }
 
     #[test]

@@ -124,7 +124,7 @@ pub(crate) fn regrow_exterior(grid: &Grid, state: &[u8], marked: &[u8]) -> Vec<u
 
 /// The 26-bit mask of the exterior neighbours of voxel `index` (bit order of
 /// [`simple::offsets`]); voxels outside the grid count as exterior.
-fn exterior_neighbours(grid: &Grid, state: &[u8], index: usize) -> u32 {
+pub(crate) fn exterior_neighbours(grid: &Grid, state: &[u8], index: usize) -> u32 {
     let c = grid.coords(index);
     let mut mask = 0;
     for (bit, o) in simple::offsets().iter().enumerate() {

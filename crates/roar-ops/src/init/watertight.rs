@@ -86,8 +86,10 @@ fn check_options(options: &InitOptions) -> Result<(), InitError> {
     {
         return bad("enclosure_winding_threshold must be finite and at least 0.5");
     }
-    if !(0.0..=1.0).contains(&options.enclosure_max_cap_fraction) {
-        return bad("enclosure_max_cap_fraction must be in [0, 1]");
+    if !(0.0..=1.0).contains(&options.enclosure_max_cap_fraction)
+        || !(0.0..=1.0).contains(&options.enclosure_max_cap_width)
+    {
+        return bad("enclosure_max_cap_fraction and enclosure_max_cap_width must be in [0, 1]");
     }
     if options.target_pieces == 0 || options.max_pieces == 0 {
         return bad("target_pieces and max_pieces must be at least 1");
@@ -116,7 +118,10 @@ fn watertight_init_from(
                 state,
                 soup,
                 threshold,
-                options.enclosure_max_cap_fraction,
+                winding_solid::CapLimits {
+                    fraction: options.enclosure_max_cap_fraction,
+                    inradius: options.enclosure_max_cap_width * options.resolution as f64,
+                },
                 &options.scanner_views,
             );
         }
@@ -184,6 +189,8 @@ fn watertight_init_from(
         voxels_filled_by_winding: enclosed.filled,
         voxels_hidden_from_scanners: enclosed.hidden,
         enclosures_left_open: enclosed.left_open,
+        winding_patches: enclosed.orientation.patches,
+        winding_patches_flipped: enclosed.orientation.flipped,
         rejected_moves: projection.rejected_moves,
         mean_distance_to_target: projection.mean_distance,
         max_distance_to_target: projection.max_distance,

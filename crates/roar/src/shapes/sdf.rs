@@ -14,7 +14,7 @@ use std::sync::{Arc, Mutex};
 
 use roar_loss::{LossError, PointCloud};
 
-use crate::shape::{InitialMesh, Shape, ShapeError};
+use crate::shape::{EnclosureFigures, InitialMesh, Shape, ShapeError};
 use roar_mesh::Mesh;
 use roar_mesh::spatial::{
     Aabb, Normalization, Projector, RIG_RADIUS, Sdf, SdfEvaluations, sample_surface,
@@ -229,8 +229,7 @@ impl Shape for SdfShape {
         Ok(InitialMesh {
             mesh,
             raw_faces,
-            voxels_filled_by_winding: 0,
-            enclosures_left_open: 0,
+            enclosure: EnclosureFigures::default(),
             merged: Default::default(),
         })
     }

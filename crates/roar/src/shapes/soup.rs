@@ -22,7 +22,7 @@ use roar_render::{Camera, Image};
 use crate::budget::{most_pieces, pieces_to_aim_for};
 use crate::config::ReconstructConfig;
 use crate::rig::target_options;
-use crate::shape::{InitialMesh, PieceMerge, Shape, ShapeError, ShapeSummary};
+use crate::shape::{EnclosureFigures, InitialMesh, PieceMerge, Shape, ShapeError, ShapeSummary};
 
 /// A triangle soup (any coordinates, anything goes) and the configuration it is cleaned up,
 /// initialised and sampled with.
@@ -140,8 +140,12 @@ impl Shape for SoupShape<'_> {
         Ok(InitialMesh {
             mesh,
             raw_faces: stats.init_faces,
-            voxels_filled_by_winding: stats.init.voxels_filled_by_winding,
-            enclosures_left_open: stats.init.enclosures_left_open,
+            enclosure: EnclosureFigures {
+                voxels_filled: stats.init.voxels_filled_by_winding,
+                left_open: stats.init.enclosures_left_open,
+                patches: stats.init.winding_patches,
+                patches_flipped: stats.init.winding_patches_flipped,
+            },
             merged: PieceMerge {
                 pieces_before: stats.init.pieces_before_merge,
                 radius_voxels: stats.init.merge_radius,

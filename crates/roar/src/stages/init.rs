@@ -60,8 +60,10 @@ fn initial_mesh(
         InitKind::Watertight => {
             let initial = shape.initial_mesh()?;
             stats.init.init_voxel_faces = initial.raw_faces;
-            stats.init.init_voxels_filled_by_winding = initial.voxels_filled_by_winding;
-            stats.init.init_enclosures_left_open = initial.enclosures_left_open;
+            stats.init.init_voxels_filled_by_winding = initial.enclosure.voxels_filled;
+            stats.init.init_enclosures_left_open = initial.enclosure.left_open;
+            stats.init.init_winding_patches = initial.enclosure.patches;
+            stats.init.init_winding_patches_flipped = initial.enclosure.patches_flipped;
             stats.init.init_pieces_before_merge = initial.merged.pieces_before;
             stats.init.init_merge_radius_voxels = initial.merged.radius_voxels;
             stats.init.init_pieces_dropped_for_budget = initial.merged.pieces_dropped;
