@@ -21,8 +21,10 @@
 //!    there, a handle the object does not have; the opening dents the solid at each hole but
 //!    cuts no tunnel, so the solid keeps the topology of the first step's, where `w` above ¼
 //!    spans those gaps and a real tunnel (`w` = 0) stays open;
-//! 3. each filled region whose caps are wide (below) is given back to the exterior, again
-//!    only through simple voxels, so what a wide opening's region plugged stays plugged.
+//! 3. each filled region whose caps are wide (below) is given back to the exterior whole: it
+//!    is an opening, and the input's shell around it stays as the flood gave it. (Opening it
+//!    through simple voxels only would leave plugs in it far from the input: c3d-beetle's
+//!    init then lies 0.024 of its diagonal from the soup on average, against 0.01 allowed.)
 //!
 //! Open surfaces and zero-thickness sheets enclose nothing: one flat sheet's `w` stays inside
 //! `(−½, ½)`, so it adds nothing past step 2, and the sheet keeps the shell the flood gives it.
@@ -93,7 +95,7 @@ pub(crate) struct EnclosedFill {
 /// every one of `views` (module `sight`) turns solid, with the pockets this cuts off from the
 /// border; then the exterior takes back, lowest winding number first, every such voxel below
 /// `threshold` whose opening changes no topology ([`open_without_tunnels`]); and each region
-/// left filled whose caps are not within `caps` is given back the same way.
+/// left filled whose caps are not within `caps` is given back to the exterior.
 /// Only voxels inside the soup's bounding box are evaluated: outside it the winding number of a
 /// closed surface is 0 and that of open sheets stays within `(−½, ½)`.
 ///
@@ -158,8 +160,10 @@ pub(crate) fn fill_enclosed(
     let threshold = threshold as f32;
     open_without_tunnels(grid, state, &mut flooded, &w, |idx| w[idx] < threshold);
     let (wide, left_open) = wide_cap_regions(grid, state, &flooded, caps);
-    if left_open > 0 {
-        open_without_tunnels(grid, state, &mut flooded, &w, |idx| wide[idx]);
+    for (idx, &wide) in wide.iter().enumerate() {
+        if wide {
+            flooded[idx] = EXTERIOR;
+        }
     }
     *state = flooded;
     let after = state.iter().filter(|&&s| s == SOLID).count();
@@ -317,7 +321,8 @@ fn winding_values(
 }
 
 /// The filled regions of `after` (6-connected voxels exterior in `before`, solid in `after`)
-/// whose caps are not within `caps`, as a mask over the grid, and how many there are. A
+/// whose caps are not within `caps`, as a mask over the grid, and how many there are; each
+/// touches the exterior through its caps, so turning it exterior keeps the exterior one flood. A
 /// region's boundary is its voxel faces towards voxels outside it: *covered* where the
 /// neighbour was solid already (the input's shell), *cap* where it is exterior still. A
 /// puncture's cap is a narrow patch; the opening of an open surface (an open box) is one wide
