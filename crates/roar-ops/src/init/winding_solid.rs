@@ -380,22 +380,11 @@ fn wide_cap_regions(
 /// the most 26-steps, within `across`, from a voxel of it to the nearest one touching the
 /// input's shell (solid in `before`); `usize::MAX` when a patch touches no shell.
 fn cap_inradius(grid: &Grid, before: &[u8], across: &HashMap<usize, usize>) -> usize {
-    let neighbours = |idx: usize| {
-        let c = grid.coords(idx).map(|x| x as i64);
-        (0..27).filter(|&d| d != 13).filter_map(move |d| {
-            let n = [c[0] + d % 3 - 1, c[1] + d / 3 % 3 - 1, c[2] + d / 9 - 1];
-            let inside = n
-                .iter()
-                .zip(grid.dims)
-                .all(|(&x, len)| (0..len as i64).contains(&x));
-            inside.then(|| grid.index(n[0] as usize, n[1] as usize, n[2] as usize))
-        })
-    };
     let mut depth: HashMap<usize, usize> = HashMap::with_capacity(across.len());
     let mut frontier: Vec<usize> = across
         .keys()
         .copied()
-        .filter(|&idx| neighbours(idx).any(|n| before[n] == SOLID))
+        .filter(|&idx| neighbours26(grid, idx).any(|n| before[n] == SOLID))
         .collect();
     frontier.sort_unstable();
     for &idx in &frontier {
@@ -406,7 +395,7 @@ fn cap_inradius(grid: &Grid, before: &[u8], across: &HashMap<usize, usize>) -> u
         level += 1;
         let mut next = Vec::new();
         for &idx in &frontier {
-            for n in neighbours(idx) {
+            for n in neighbours26(grid, idx) {
                 if across.contains_key(&n) && !depth.contains_key(&n) {
                     depth.insert(n, level);
                     next.push(n);
@@ -434,17 +423,7 @@ fn widest_cap(grid: &Grid, across: &HashMap<usize, usize>) -> usize {
         let mut faces = 0;
         while let Some(idx) = stack.pop() {
             faces += across[&idx];
-            let c = grid.coords(idx).map(|x| x as i64);
-            for d in 0..27 {
-                let n = [c[0] + d % 3 - 1, c[1] + d / 3 % 3 - 1, c[2] + d / 9 - 1];
-                let inside = n
-                    .iter()
-                    .zip(grid.dims)
-                    .all(|(&x, len)| (0..len as i64).contains(&x));
-                if !inside {
-                    continue;
-                }
-                let n = grid.index(n[0] as usize, n[1] as usize, n[2] as usize);
+            for n in neighbours26(grid, idx) {
                 if across.contains_key(&n) && done.insert(n) {
                     stack.push(n);
                 }
@@ -453,6 +432,19 @@ fn widest_cap(grid: &Grid, across: &HashMap<usize, usize>) -> usize {
         widest = widest.max(faces);
     }
     widest
+}
+
+/// The voxels sharing a face, an edge or a corner with voxel `idx`, inside the grid.
+fn neighbours26(grid: &Grid, idx: usize) -> impl Iterator<Item = usize> + '_ {
+    let c = grid.coords(idx).map(|x| x as i64);
+    (0..27).filter(|&d| d != 13).filter_map(move |d| {
+        let n = [c[0] + d % 3 - 1, c[1] + d / 3 % 3 - 1, c[2] + d / 9 - 1];
+        let inside = n
+            .iter()
+            .zip(grid.dims)
+            .all(|(&x, len)| (0..len as i64).contains(&x));
+        inside.then(|| grid.index(n[0] as usize, n[1] as usize, n[2] as usize))
+    })
 }
 
 fn bounds(points: &[DVec3]) -> (DVec3, DVec3) {
