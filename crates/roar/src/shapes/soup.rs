@@ -114,6 +114,7 @@ impl Shape for SoupShape<'_> {
                 enclosure_winding_threshold: (self.config.init.enclosure_winding_threshold > 0.0)
                     .then_some(self.config.init.enclosure_winding_threshold),
                 enclosure_max_cap_fraction: self.config.init.enclosure_max_cap_fraction,
+                enclosure_max_cap_width: self.config.init.enclosure_max_cap_width,
                 scanner_views: self
                     .scanner_views
                     .iter()
