@@ -31,13 +31,16 @@
 //!
 //! **Punctures, not openings.** An open surface that wraps around a volume (a cup, an open box,
 //! a head open at the neck) has `w` above ½ inside too, and filling it would add a cap that is
-//! not in the input. So each filled region (6-connected) is kept only if its *caps* (the
+//! not in the input. So each filled region (26-connected) is kept only if its *caps* (the
 //! connected patches of its boundary towards the exterior, i.e. not against the input's shell) are
-//! narrow: no point of it farther than [`CapLimits::inradius`] voxels from the input's shell (a
-//! hole is narrower than the object; the opening of an open box is as wide as the box), and at
-//! most [`CapLimits::fraction`] of the region's boundary (the thin layer on the concave side of
-//! a curved sheet, where `w` is just above ½, is capped on almost all its boundary).
-//! docs/method.md gives the figures that chose the defaults.
+//! narrow: no point of them farther than [`CapLimits::inradius`] voxels from the input's shell (a
+//! hole is narrower than the object; the opening of an open box is as wide as the box), and the
+//! widest at most [`CapLimits::fraction`] of the region's boundary (the thin layer on the
+//! concave side of a curved sheet, where `w` is just above ½, is capped on almost all its
+//! boundary), or, if wider, one hole of several: at most [`SHARED_CAP_SHARE`] of all its caps
+//! and [`SHARED_CAP_FRACTION`] of its boundary (a container has one opening, a surface punctured
+//! all over many holes, some merged into wide gaps). docs/method.md gives the figures that chose
+//! the defaults.
 //!
 //! **Where the rule fails.** (a) A piece seen equally from both sides (module `orient`) keeps
 //! the orientation it came with; if it was stored inside out, `w` inside is lower there. (b)
@@ -60,7 +63,8 @@ use std::collections::{HashMap, HashSet};
 /// How narrow a filled region's caps must be for it to stay filled (module doc).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(crate) struct CapLimits {
-    /// Most faces of the widest cap, as a fraction of the region's boundary faces.
+    /// Most faces of the widest cap, as a fraction of the region's boundary faces (wider ones
+    /// may pass as one hole of several, [`SHARED_CAP_SHARE`]).
     pub fraction: f64,
     /// Most 26-steps from a cap voxel to the nearest one touching the input's shell.
     pub inradius: f64,
@@ -74,6 +78,14 @@ impl CapLimits {
         inradius: f64::INFINITY,
     };
 }
+
+/// A region whose widest cap is wider than [`CapLimits::fraction`] stays filled still if that
+/// cap holds at most this share of all its caps (a punctured surface has many holes, a
+/// container one opening) ...
+const SHARED_CAP_SHARE: f64 = 0.75;
+
+/// ... and covers at most this fraction of its boundary.
+const SHARED_CAP_FRACTION: f64 = 0.3;
 
 /// What [`fill_enclosed`] did.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -160,12 +172,12 @@ pub(crate) fn fill_enclosed(
     let threshold = threshold as f32;
     open_without_tunnels(grid, state, &mut flooded, &w, |idx| w[idx] < threshold);
     let (wide, left_open) = wide_cap_regions(grid, state, &flooded, caps);
-    for (idx, &wide) in wide.iter().enumerate() {
-        if wide {
-            flooded[idx] = EXTERIOR;
-        }
-    }
-    *state = flooded;
+    // A wide region's voxels with no path to its caps (a part joined to the rest by an edge or
+    // a corner only) stay solid: the exterior is one flood from the border.
+    let blocked: Vec<u8> = (0..grid.len())
+        .map(|idx| u8::from(flooded[idx] == SOLID && !wide[idx]))
+        .collect();
+    *state = solid::flood_exterior(grid, &blocked);
     let after = state.iter().filter(|&&s| s == SOLID).count();
     EnclosedFill {
         evaluated,
@@ -320,13 +332,13 @@ fn winding_values(
     (out, evaluated + points.len())
 }
 
-/// The filled regions of `after` (6-connected voxels exterior in `before`, solid in `after`)
-/// whose caps are not within `caps`, as a mask over the grid, and how many there are; each
-/// touches the exterior through its caps, so turning it exterior keeps the exterior one flood. A
+/// The filled regions of `after` (26-connected voxels exterior in `before`, solid in `after`)
+/// whose caps are not within `caps`, as a mask over the grid, and how many there are. A
 /// region's boundary is its voxel faces towards voxels outside it: *covered* where the
 /// neighbour was solid already (the input's shell), *cap* where it is exterior still. A
-/// puncture's cap is a narrow patch; the opening of an open surface (an open box) is one wide
-/// patch.
+/// puncture's cap is a narrow patch, one of several; the opening of an open surface (an open
+/// box) is one wide patch. Regions are 26-connected so that the small pockets the opening
+/// leaves beside a region, joined to it by an edge or a corner, are judged with it.
 fn wide_cap_regions(
     grid: &Grid,
     before: &[u8],
@@ -350,12 +362,14 @@ fn wide_cap_regions(
         while next < region.len() {
             let idx = region[next];
             next += 1;
+            for n in neighbours26(grid, idx) {
+                if is_filled(n) && !seen[n] {
+                    seen[n] = true;
+                    region.push(n);
+                }
+            }
             for n in solid::face_neighbours(grid, idx).into_iter().flatten() {
                 if is_filled(n) {
-                    if !seen[n] {
-                        seen[n] = true;
-                        region.push(n);
-                    }
                     continue;
                 }
                 boundary += 1;
@@ -364,7 +378,12 @@ fn wide_cap_regions(
                 }
             }
         }
-        let too_wide = widest_cap(grid, &across) as f64 > caps.fraction * boundary as f64
+        let widest = widest_cap(grid, &across) as f64;
+        let cap_faces: usize = across.values().sum();
+        let boundary = boundary as f64;
+        let one_of_several = widest <= SHARED_CAP_SHARE * cap_faces as f64
+            && widest <= caps.fraction.max(SHARED_CAP_FRACTION) * boundary;
+        let too_wide = !(widest <= caps.fraction * boundary || one_of_several)
             || cap_inradius(grid, before, &across) as f64 > caps.inradius;
         if too_wide {
             for idx in region {
@@ -550,6 +569,49 @@ mod tests {
             state[grid.index(mid.x as usize, mid.y as usize, mid.z as usize)],
             SOLID
         );
+    }
+
+    /// The unit box whose top lacks the squares `[x, x + 0.45] × [y, y + 0.45]` at `corners`.
+    fn box_with_holes(corners: &[(f64, f64)]) -> Vec<[DVec3; 3]> {
+        let mut soup = box_soup(DVec3::ZERO, DVec3::ONE, true);
+        let c = |x: f64, y: f64| DVec3::new(x, y, 1.0);
+        let cuts = [0.0, 0.02, 0.47, 0.53, 0.98, 1.0];
+        for (x0, x1) in cuts.iter().zip(&cuts[1..]) {
+            for (y0, y1) in cuts.iter().zip(&cuts[1..]) {
+                if corners.contains(&(*x0, *y0)) {
+                    continue;
+                }
+                soup.push([c(*x0, *y0), c(*x1, *y0), c(*x1, *y1)]);
+                soup.push([c(*x0, *y0), c(*x1, *y1), c(*x0, *y1)]);
+            }
+        }
+        soup
+    }
+
+    #[test]
+    fn one_wide_hole_stays_open_and_several_close() {
+        // Each hole is about 3.4 % of the inside's boundary, wider than the 2 % of the defaults,
+        // and narrow enough for the width limit (5.4 of its 6 voxels).
+        let grid = Grid::around(DVec3::ZERO, DVec3::ONE, 24, 3);
+        let defaults = CapLimits {
+            fraction: super::super::ENCLOSURE_MAX_CAP_FRACTION,
+            inradius: super::super::ENCLOSURE_MAX_CAP_WIDTH * 24.0,
+        };
+        let mid = grid.to_grid(DVec3::splat(0.5)).floor();
+        let mid = grid.index(mid.x as usize, mid.y as usize, mid.z as usize);
+        // One hole: the opening of a container.
+        let one = box_with_holes(&[(0.02, 0.02)]);
+        let mut state = flooded(&grid, &one);
+        let reference = state.clone();
+        let fill = fill_enclosed(&grid, &mut state, &one, 0.5, defaults, &[]);
+        assert_eq!((fill.filled, fill.left_open), (0, 1), "{fill:?}");
+        assert_eq!(state, reference);
+        // Four holes alike, a quarter of the caps each: a punctured surface.
+        let four = box_with_holes(&[(0.02, 0.02), (0.02, 0.53), (0.53, 0.02), (0.53, 0.53)]);
+        let mut state = flooded(&grid, &four);
+        let fill = fill_enclosed(&grid, &mut state, &four, 0.5, defaults, &[]);
+        assert!(fill.filled > 0 && fill.left_open == 0, "{fill:?}");
+        assert_eq!(state[mid], SOLID);
     }
 
     #[test]
