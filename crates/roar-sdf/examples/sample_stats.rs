@@ -46,11 +46,23 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut angles: Vec<f64> = (0..points.len())
         .map(|i| 1.0 - gs[i].normalize_or_zero().dot(g[i].normalize_or_zero()))
         .collect();
+    // Query speed: a million points of the cube, values and then values with gradients.
+    let many: Vec<DVec3> = (0..1_000_000)
+        .map(|i| points[i % points.len()] + DVec3::splat(fine * ((i % 13) as f64 - 6.0)))
+        .collect();
+    let mut v = vec![0.0; many.len()];
+    let mut d = vec![DVec3::ZERO; many.len()];
+    let clock = std::time::Instant::now();
+    sampled.values(&many, &mut v);
+    let values_seconds = clock.elapsed().as_secs_f64();
+    let clock = std::time::Instant::now();
+    sampled.values_and_gradients(&many, &mut v, &mut d);
+    let gradients_seconds = clock.elapsed().as_secs_f64();
     errors.sort_by(f64::total_cmp);
     angles.sort_by(f64::total_cmp);
     let at = |v: &[f64], q: f64| v[((v.len() - 1) as f64 * q) as usize];
     println!(
-        "{{\"resolution\": {resolution}, \"coarse\": {}, \"band\": {band}, \"field_evaluations\": {}, \"cells\": {}, \"finest_leaves\": {}, \"mb\": {:.1}, \"seconds\": {:.2}, \"median_gradient\": {:.3}, \"error_cells_median\": {:.2e}, \"error_cells_p99\": {:.2e}, \"normal_1mcos_median\": {:.2e}, \"normal_1mcos_p99\": {:.2e}, \"points\": {}}}",
+        "{{\"resolution\": {resolution}, \"coarse\": {}, \"band\": {band}, \"field_evaluations\": {}, \"cells\": {}, \"finest_leaves\": {}, \"mb\": {:.1}, \"seconds\": {:.2}, \"median_gradient\": {:.3}, \"error_cells_median\": {:.2e}, \"error_cells_p99\": {:.2e}, \"normal_1mcos_median\": {:.2e}, \"normal_1mcos_p99\": {:.2e}, \"points\": {}, \"seconds_per_million_values\": {:.2}, \"seconds_per_million_gradients\": {:.2}}}",
         options.coarse_resolution,
         stats.field_evaluations,
         stats.cells,
@@ -62,7 +74,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         at(&errors, 0.99),
         at(&angles, 0.5),
         at(&angles, 0.99),
-        points.len()
+        points.len(),
+        values_seconds,
+        gradients_seconds
     );
     Ok(())
 }

@@ -124,6 +124,15 @@ struct Cell {
     children: u32,
 }
 
+/// One lattice point's value and gradient, together in one aligned block so a query reads one
+/// cache line per corner.
+#[derive(Clone, Copy, Debug)]
+#[repr(align(32))]
+struct Sample {
+    value: f64,
+    gradient: [f64; 3],
+}
+
 /// A field's values and gradients on an adaptive octree, interpolated with gradients
 /// ([`SampledSdf::build`]). Counts its own queries, apart from the field's evaluations.
 pub struct SampledSdf {
@@ -139,8 +148,7 @@ pub struct SampledSdf {
     levels: u32,
     /// The root cells (`coarse³`, x fastest) first, then every split's 8 children.
     cells: Vec<Cell>,
-    values: Vec<f64>,
-    gradients: Vec<DVec3>,
+    samples: Vec<Sample>,
     median_gradient: f64,
     counter: SdfCounter,
 }
@@ -313,13 +321,19 @@ impl SampledSdf {
             coarse,
             levels,
             cells,
-            values,
-            gradients,
+            samples: values
+                .iter()
+                .zip(&gradients)
+                .map(|(&value, g)| Sample {
+                    value,
+                    gradient: g.to_array(),
+                })
+                .collect(),
             median_gradient,
             counter: SdfCounter::default(),
         };
         let stats = SampleStats {
-            field_evaluations: sampled.values.len(),
+            field_evaluations: sampled.samples.len(),
             cells: sampled.cells.len(),
             finest_leaves,
             bytes: sampled.bytes(),
@@ -332,8 +346,7 @@ impl SampledSdf {
     /// Bytes of the stored samples and octree.
     pub fn bytes(&self) -> usize {
         self.cells.len() * std::mem::size_of::<Cell>()
-            + self.values.len() * std::mem::size_of::<f64>()
-            + self.gradients.len() * std::mem::size_of::<DVec3>()
+            + self.samples.len() * std::mem::size_of::<Sample>()
     }
 
     /// The sampled field's value and gradient at `p` (the module's interpolation; outside the
@@ -355,8 +368,27 @@ impl SampledSdf {
         (value + distance * self.median_gradient, gradient)
     }
 
-    /// The interpolation at `p`, a point of the cube.
-    fn eval_inside(&self, p: DVec3) -> (f64, DVec3) {
+    /// The sampled field's value at `p` (as [`SampledSdf::eval`], without the gradient).
+    pub fn value(&self, p: DVec3) -> f64 {
+        let side = self.fine * f64::from(self.resolution);
+        let q = p.clamp(self.origin, self.origin + DVec3::splat(side));
+        let (cell, base, h) = self.leaf(q);
+        let t = ((q - base) / h).clamp(DVec3::ZERO, DVec3::ONE);
+        let mut value = 0.0;
+        for (c, &index) in cell.corners.iter().enumerate() {
+            let w = (if c & 1 == 1 { t.x } else { 1.0 - t.x })
+                * (if c & 2 == 2 { t.y } else { 1.0 - t.y })
+                * (if c & 4 == 4 { t.z } else { 1.0 - t.z });
+            let x = base + h * DVec3::new((c & 1) as f64, ((c >> 1) & 1) as f64, (c >> 2) as f64);
+            let sample = &self.samples[index as usize];
+            let g = DVec3::from_array(sample.gradient);
+            value += w * (sample.value + 0.5 * g.dot(q - x));
+        }
+        value + (p - q).length() * self.median_gradient
+    }
+
+    /// The leaf holding `p`, a point of the cube, with its lowest corner and side.
+    fn leaf(&self, p: DVec3) -> (Cell, DVec3, f64) {
         // Finest-lattice coordinates, and the coarse cell holding them.
         let u = (p - self.origin) / self.fine;
         let step = self.resolution / self.coarse;
@@ -387,6 +419,12 @@ impl SampledSdf {
         let h = self.fine * f64::from(size);
         let base =
             self.origin + self.fine * DVec3::new(low[0].into(), low[1].into(), low[2].into());
+        (cell, base, h)
+    }
+
+    /// The interpolation at `p`, a point of the cube.
+    fn eval_inside(&self, p: DVec3) -> (f64, DVec3) {
+        let (cell, base, h) = self.leaf(p);
         let t = ((p - base) / h).clamp(DVec3::ZERO, DVec3::ONE);
         let mut value = 0.0;
         let mut gradient = DVec3::ZERO;
@@ -409,8 +447,9 @@ impl SampledSdf {
                 factor[0] * factor[1] * slope[2],
             );
             let x = base + h * DVec3::new(bits[0] as f64, bits[1] as f64, bits[2] as f64);
-            let g = self.gradients[index as usize];
-            let local = self.values[index as usize] + 0.5 * g.dot(p - x);
+            let sample = &self.samples[index as usize];
+            let g = DVec3::from_array(sample.gradient);
+            let local = sample.value + 0.5 * g.dot(p - x);
             value += w * local;
             gradient += dw * local + 0.5 * w * g;
         }
@@ -451,7 +490,7 @@ impl Sdf for SampledSdf {
             .zip(values.par_chunks_mut(QUERY_CHUNK))
             .for_each(|(p, v)| {
                 for (p, v) in p.iter().zip(v) {
-                    *v = self.eval(*p).0;
+                    *v = self.value(*p);
                 }
             });
     }
@@ -590,6 +629,9 @@ mod tests {
             let p = p.normalize_or_zero() * (0.6 + 0.01 * p.x);
             let error = (sampled.eval(p).0 - sphere(p)).abs();
             assert!(error < 1e-2 * cell, "{p}: error {error}");
+        }
+        for p in points(500, 1.5) {
+            assert_eq!(sampled.value(p), sampled.eval(p).0, "{p}");
         }
         // The sampled field counts its own queries, and the field sees none of them.
         let before = field.evaluations();
