@@ -170,6 +170,8 @@ fn reconstruct(
     assert!(!intersecting.contains(&true), "self-intersecting faces");
     let mesh = Mesh::from_triangles(out.positions.clone(), &out.triangles)
         .expect("a closed, oriented 2-manifold");
+    // The run's counts, before the distances below evaluate the field.
+    let report = shape.report();
     let (values, gradients) = evaluate_with_gradients(field.as_ref(), &out.positions);
     let mut distances: Vec<f64> = values
         .iter()
@@ -180,15 +182,25 @@ fn reconstruct(
     let mean = distances.iter().sum::<f64>() / distances.len() as f64;
     let p99 = distances[distances.len() * 99 / 100];
     let max = distances[distances.len() - 1];
-    let report = shape.report();
     println!(
         "{faces} faces: genus {}, zero-set distance mean {mean:.2e} p99 {p99:.2e} max {max:.2e}; \
-         evaluations {:?} {:?}; trace {:.2} s",
+         evaluations {:?} {:?}; sampled-field queries {:?} {:?}; trace {:.2} s",
         mesh.genus(),
         report.values,
         report.gradients,
+        report.sampled_values,
+        report.sampled_gradients,
         report.trace_seconds
     );
+    // The field is evaluated by the sampling alone, within issue #52's cap (a 128³ grid's
+    // count), and every later stage reads the samples.
+    let sampled = report
+        .sample
+        .expect("the field is sampled")
+        .field_evaluations as u64;
+    let total: u64 = report.values.values().sum::<u64>() + report.gradients.values().sum::<u64>();
+    assert_eq!(total, sampled, "field evaluations outside the sampling");
+    assert!(total <= 2_100_000, "{total} field evaluations");
     (mesh, [mean, p99, max])
 }
 

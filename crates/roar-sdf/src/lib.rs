@@ -5,7 +5,8 @@
 //! `.npz` or an IDR/VolSDF/NeuS `.safetensors` state dict ([`implicit_network`]), a dense `.npy`
 //! grid [`GridSdf`]), all behind `roar_mesh::spatial::Sdf`, and what the pipeline needs from a
 //! field: its normal maps by grid-bracketed tracing ([`trace`]), the Face Split projector and the
-//! projection of samples onto the zero set ([`project`]), the field in rig coordinates
+//! projection of samples onto the zero set ([`project`]), one adaptive sampling of the field
+//! that every stage reads ([`sampled`]), the field in rig coordinates
 //! ([`RigSdf`]), and the marching baseline that samples a field on a grid and extracts its zero set
 //! ([`extract`]).
 
@@ -16,6 +17,7 @@ pub mod grid;
 pub mod implicit_network;
 pub mod network;
 pub mod project;
+pub mod sampled;
 pub mod trace;
 
 use std::path::Path;
@@ -30,6 +32,7 @@ pub use extract::{ExtractOptions, ExtractStats, extract_zero_set};
 pub use grid::GridSdf;
 pub use network::{Activation, Mlp};
 pub use project::{SdfProjector, SdfProjectorOptions, project_samples};
+pub use sampled::{SampleOptions, SampleStats, SampledSdf};
 pub use trace::{TraceOptions, TraceStats, trace_normal_maps};
 
 /// The bounds an SDF input is reconstructed in, and a grid without a sidecar is placed over,

@@ -35,6 +35,9 @@ pub enum ShapeError {
     /// No initial mesh could be made.
     #[error("init: {0}")]
     Init(String),
+    /// A field could not be sampled (a non-finite value, bad sampling options).
+    #[error("{0}")]
+    Field(String),
 }
 
 /// The initial closed mesh M0 of a shape, with how many faces it had before any decimation.

@@ -323,7 +323,7 @@ fn summary(args: &ReconstructArgs, report: &ReconstructReport) -> String {
     }
     if let Some(sdf) = &report.sdf {
         text += &format!(
-            "  field     mean distance of the vertices to the zero set {:.3e}, {} evaluations\n",
+            "  field     mean distance of the vertices to the zero set {:.3e}, {} field evaluations\n",
             sdf.output_distance_mean,
             sdf.evaluations.values.values().sum::<u64>()
                 + sdf.evaluations.gradients.values().sum::<u64>()

@@ -2,6 +2,8 @@
 //! reads from `.npz` and `.safetensors` networks, `.sdf.toml` files and `.npy` grids (`roar_sdf`).
 //!
 //! In rig coordinates (the bounds' centre at the origin, their corners on the rig's sphere): the
+//! field is sampled once, adaptively (`roar_sdf::sampled`, the report's stage `sample`), and
+//! every later stage reads the samples instead of the field (unless `sdf_sample` is off); the
 //! target renders are traced normal maps of the zero set (`roar_sdf::trace`); the initial mesh is
 //! the voxel init of `f < 0` on a `sdf_init_resolution` grid over the bounds (supplementary §3),
 //! decimated to `init_max_faces`; the point cloud is samples of that init projected onto the zero
@@ -21,7 +23,10 @@ use roar_mesh::spatial::{
 };
 use roar_ops::init::{InitialMeshOptions, SdfInitOptions, initial_mesh_from_init, sdf_init};
 use roar_render::{Camera, Image};
-use roar_sdf::{RigSdf, SdfProjector, SdfProjectorOptions, TraceOptions, TraceStats};
+use roar_sdf::{
+    RigSdf, SampleOptions, SampleStats, SampledSdf, SdfProjector, SdfProjectorOptions,
+    TraceOptions, TraceStats,
+};
 use serde::Serialize;
 
 use crate::config::ReconstructConfig;
@@ -32,12 +37,21 @@ pub const DEFAULT_BOUNDS: Aabb = roar_sdf::DEFAULT_BOUNDS;
 /// Evaluations of an SDF input's field by what asked for them, for reports.
 #[derive(Clone, Debug, Default, Serialize)]
 pub struct SdfReport {
-    /// Points evaluated for values, by stage: `trace` (the target renders), `init` (the voxel
-    /// init), `point_cloud`, `loop` (the SDF loss, the Face Split projector and the finish's fit
-    /// to the zero set), and `preview` (the `--preview` picture's input views, when asked for).
+    /// Points the **field** evaluated for values, by stage: `sample` (the adaptive sampling),
+    /// `trace` (the target renders), `init` (the voxel init), `point_cloud`, `loop` (the SDF
+    /// loss, the Face Split projector and the finish's fit to the zero set), and `preview` (the
+    /// `--preview` picture's input views, when asked for). With the sampling on, every stage
+    /// after `sample` reads the samples, so the field's counts are there and nowhere else.
     pub values: BTreeMap<&'static str, u64>,
-    /// Points evaluated for values and gradients, by the same stages.
+    /// Points the field evaluated for values and gradients, by the same stages.
     pub gradients: BTreeMap<&'static str, u64>,
+    /// Queries of the sampled field (not the field's evaluations) for values, by stage; empty
+    /// when the sampling is off.
+    pub sampled_values: BTreeMap<&'static str, u64>,
+    /// Queries of the sampled field for values and gradients, by stage.
+    pub sampled_gradients: BTreeMap<&'static str, u64>,
+    /// What the sampling did (absent when it is off).
+    pub sample: Option<SampleStats>,
     /// The tracer's figures (rays, hits, seconds).
     pub trace_rays: usize,
     /// Rays that hit the zero set.
@@ -54,12 +68,16 @@ pub struct SdfShape {
     field: Arc<dyn Sdf>,
     bounds: Aabb,
     rig: Arc<RigSdf>,
+    /// The sampled field in rig coordinates, made by [`SdfShape::sample`].
+    sampled: Option<Arc<SampledSdf>>,
+    sample_stats: Option<SampleStats>,
     projector: SdfProjector,
     config: ReconstructConfig,
     /// The rig and its renders, made by [`Shape::prepare`].
     renders: Option<(Vec<Camera>, Vec<Image>)>,
-    /// Evaluations so far, by stage (a lock: `Shape` methods take `&self`).
-    counts: Mutex<Vec<(&'static str, SdfEvaluations)>>,
+    /// The field's evaluations and the sampled field's queries so far, by stage (a lock:
+    /// `Shape` methods take `&self`).
+    counts: Mutex<Vec<(&'static str, SdfEvaluations, SdfEvaluations)>>,
     trace: Mutex<TraceStats>,
 }
 
@@ -92,6 +110,8 @@ impl SdfShape {
             field,
             bounds,
             rig,
+            sampled: None,
+            sample_stats: None,
             projector,
             config: config.clone(),
             renders: None,
@@ -105,6 +125,43 @@ impl SdfShape {
         &self.field
     }
 
+    /// Samples the field once over the bounds (`roar_sdf::SampledSdf`, charged to stage
+    /// `sample`), after which every stage reads the samples; does nothing when the field is
+    /// sampled already or `sdf_sample` is off. [`Shape::prepare`] calls it first.
+    pub fn sample(&mut self) -> Result<(), ShapeError> {
+        if self.sampled.is_some() || !self.config.target.sdf_sample {
+            return Ok(());
+        }
+        let options = sample_options(&self.config);
+        let bounds = self.rig_bounds();
+        let (sampled, stats) = self
+            .counted("sample", || {
+                SampledSdf::build(self.rig.as_ref(), bounds, &options)
+            })
+            .map_err(|e| ShapeError::Field(format!("{}: {e}", self.name)))?;
+        let sampled = Arc::new(sampled);
+        self.projector.sdf = sampled.clone();
+        self.sampled = Some(sampled);
+        self.sample_stats = Some(stats);
+        Ok(())
+    }
+
+    /// What the stages read, in rig coordinates: the samples once made, else the field.
+    fn query(&self) -> Arc<dyn Sdf> {
+        match &self.sampled {
+            Some(sampled) => sampled.clone(),
+            None => self.rig.clone(),
+        }
+    }
+
+    /// The sampled field's queries so far (zeros before the sampling).
+    fn queries(&self) -> SdfEvaluations {
+        self.sampled
+            .as_ref()
+            .map(|s| s.evaluations())
+            .unwrap_or_default()
+    }
+
     /// The bounds in rig coordinates.
     fn rig_bounds(&self) -> Aabb {
         let n = self.rig.normalization;
@@ -114,17 +171,15 @@ impl SdfShape {
         }
     }
 
-    /// Runs `work`, charging the field's evaluations meanwhile to `stage`.
+    /// Runs `work`, charging the field's evaluations and the sampled field's queries meanwhile
+    /// to `stage`.
     fn counted<T>(&self, stage: &'static str, work: impl FnOnce() -> T) -> T {
-        let before = self.field.evaluations();
+        let (before, queried) = (self.field.evaluations(), self.queries());
         let out = work();
-        let after = self.field.evaluations();
-        let delta = SdfEvaluations {
-            values: after.values - before.values,
-            gradients: after.gradients - before.gradients,
-        };
+        let field = difference(self.field.evaluations(), before);
+        let queries = difference(self.queries(), queried);
         if let Ok(mut counts) = self.counts.lock() {
-            counts.push((stage, delta));
+            counts.push((stage, field, queries));
         }
         out
     }
@@ -135,7 +190,12 @@ impl SdfShape {
             refine_steps: self.config.target.sdf_trace_refine_steps,
         };
         let (images, stats) = self.counted("trace", || {
-            roar_sdf::trace_normal_maps(self.rig.as_ref(), &self.rig_bounds(), cameras, &options)
+            roar_sdf::trace_normal_maps(
+                self.query().as_ref(),
+                &self.rig_bounds(),
+                cameras,
+                &options,
+            )
         });
         if let Ok(mut trace) = self.trace.lock() {
             trace.rays += stats.rays;
@@ -155,26 +215,51 @@ impl SdfShape {
             refine_steps: self.config.target.sdf_trace_refine_steps,
         };
         self.counted("preview", || {
-            roar_sdf::trace_normal_maps(self.rig.as_ref(), &self.rig_bounds(), cameras, &options).0
+            roar_sdf::trace_normal_maps(
+                self.query().as_ref(),
+                &self.rig_bounds(),
+                cameras,
+                &options,
+            )
+            .0
         })
     }
 
-    /// The field's evaluations by stage so far, for the report (what no stage claimed is
-    /// charged to `loop`).
+    /// The field's evaluations and the sampled field's queries by stage so far, for the report
+    /// (what no stage claimed is charged to `loop`).
     pub fn report(&self) -> SdfReport {
-        let mut report = SdfReport::default();
-        let total = self.field.evaluations();
-        let (mut values, mut gradients) = (0, 0);
+        let mut report = SdfReport {
+            sample: self.sample_stats,
+            ..SdfReport::default()
+        };
+        let (total, queried) = (self.field.evaluations(), self.queries());
+        let (mut field, mut queries) = (SdfEvaluations::default(), SdfEvaluations::default());
         if let Ok(counts) = self.counts.lock() {
-            for (stage, e) in counts.iter() {
+            for (stage, e, q) in counts.iter() {
                 *report.values.entry(stage).or_default() += e.values;
                 *report.gradients.entry(stage).or_default() += e.gradients;
-                values += e.values;
-                gradients += e.gradients;
+                field.values += e.values;
+                field.gradients += e.gradients;
+                if self.sampled.is_some() {
+                    *report.sampled_values.entry(stage).or_default() += q.values;
+                    *report.sampled_gradients.entry(stage).or_default() += q.gradients;
+                }
+                queries.values += q.values;
+                queries.gradients += q.gradients;
             }
         }
-        report.values.insert("loop", total.values - values);
-        report.gradients.insert("loop", total.gradients - gradients);
+        report.values.insert("loop", total.values - field.values);
+        report
+            .gradients
+            .insert("loop", total.gradients - field.gradients);
+        if self.sampled.is_some() {
+            report
+                .sampled_values
+                .insert("loop", queried.values - queries.values);
+            report
+                .sampled_gradients
+                .insert("loop", queried.gradients - queries.gradients);
+        }
         if let Ok(trace) = self.trace.lock() {
             report.trace_rays = trace.rays;
             report.trace_hits = trace.hits;
@@ -193,6 +278,7 @@ impl Shape for SdfShape {
     /// Traces the target renders for `cameras` (the costly step: a grid of values, then a few
     /// evaluations per pixel that sees the surface).
     fn prepare(&mut self, cameras: &[Camera]) -> Result<(), ShapeError> {
+        self.sample()?;
         let images = self.trace(cameras);
         if !images.iter().flatten().any(|p| p[3] > 0.0) {
             return Err(ShapeError::Loss(LossError::InvalidTarget(format!(
@@ -216,7 +302,7 @@ impl Shape for SdfShape {
         };
         let init = self
             .counted("init", || {
-                sdf_init(self.rig.as_ref(), bounds.min, bounds.max, &options)
+                sdf_init(self.query().as_ref(), bounds.min, bounds.max, &options)
             })
             .map_err(|e| ShapeError::Init(format!("{}: {e}", self.name)))?;
         let raw_faces = init.triangles.len();
@@ -244,7 +330,7 @@ impl Shape for SdfShape {
         );
         let (points, normals) = self.counted("point_cloud", || {
             roar_sdf::project_samples(
-                self.rig.as_ref(),
+                self.query().as_ref(),
                 samples.points,
                 self.config.target.sdf_projection_steps,
                 self.config.target.sdf_projection_tolerance,
@@ -267,7 +353,7 @@ impl Shape for SdfShape {
     }
 
     fn signed_distance(&self) -> Option<Arc<dyn Sdf>> {
-        Some(self.rig.clone())
+        Some(self.query())
     }
 
     /// The field's projector ([`SdfProjector`]) unless `sdf_split_projector` is off.
@@ -277,4 +363,29 @@ impl Shape for SdfShape {
             .sdf_split_projector
             .then_some(&self.projector as &dyn Projector)
     }
+}
+
+/// `a − b`, counter by counter.
+fn difference(a: SdfEvaluations, b: SdfEvaluations) -> SdfEvaluations {
+    SdfEvaluations {
+        values: a.values - b.values,
+        gradients: a.gradients - b.gradients,
+    }
+}
+
+/// The sampling's options from the configuration: `sdf_sample_resolution`, or when it is 0 the
+/// resolution the face budget needs ([`auto_sample_resolution`]), with the coarse grid
+/// [`SampleOptions::for_resolution`] gives and `sdf_sample_band`.
+pub fn sample_options(config: &ReconstructConfig) -> SampleOptions {
+    let resolution = match config.target.sdf_sample_resolution {
+        0 => auto_sample_resolution(config.faces),
+        r => r,
+    };
+    SampleOptions::for_resolution(resolution, config.target.sdf_sample_band)
+}
+
+/// The sampling's resolution for a budget of `faces`: 256 up to 10,000 faces, 384 above
+/// (`docs/sdf.md`, "Sampling").
+pub fn auto_sample_resolution(faces: usize) -> usize {
+    if faces <= 10_000 { 256 } else { 384 }
 }
