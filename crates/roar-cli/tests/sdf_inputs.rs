@@ -35,10 +35,10 @@ fn print_config_of_an_sdf_input_gives_the_sdf_schedule() {
     assert!(out.status.success());
     let config: ReconstructConfig = toml::from_str(&String::from_utf8_lossy(&out.stdout)).unwrap();
     assert_eq!(config, ReconstructConfig::sdf_defaults());
-    assert_eq!((config.optimize.iterations, config.faces), (700, 50_000));
+    assert_eq!((config.optimize.iterations, config.faces), (150, 50_000));
     assert_eq!(
         (config.loss.sdf_loss_weight, config.loss.sdf_loss_start),
-        (0.1, 500)
+        (0.1, 100)
     );
     // A config file's keys go over the SDF defaults, not the soup's.
     let file = dir.path().join("c.toml");
@@ -59,7 +59,7 @@ fn print_config_of_an_sdf_input_gives_the_sdf_schedule() {
         file.to_str().unwrap(),
     ]);
     let config: ReconstructConfig = toml::from_str(&String::from_utf8_lossy(&out.stdout)).unwrap();
-    assert_eq!((config.optimize.iterations, config.faces), (700, 1000));
+    assert_eq!((config.optimize.iterations, config.faces), (150, 1000));
 }
 
 #[test]
