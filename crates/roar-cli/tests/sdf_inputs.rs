@@ -192,8 +192,8 @@ fn reconstruct(
         report.sampled_gradients,
         report.trace_seconds
     );
-    // The field is evaluated by the sampling alone, within issue #52's cap (a 128³ grid's
-    // count), and every later stage reads the samples.
+    // The field is evaluated by the sampling alone, within a 128³ grid's count, and every later
+    // stage reads the samples.
     let sampled = report
         .sample
         .expect("the field is sampled")
@@ -207,20 +207,9 @@ fn reconstruct(
 #[test]
 #[ignore = "release: reduced SDF reconstructions (run by .ci/run)"]
 fn analytic_box_minus_cylinder_has_genus_one_and_a_sphere_is_within_one_percent() {
-    let drilled = AnalyticSdf::from_toml(
-        r#"
-[shape]
-type = "difference"
-[[shape.children]]
-type = "box"
-half_extents = [0.6, 0.6, 0.35]
-[[shape.children]]
-type = "cylinder"
-radius = 0.25
-half_height = 1.0
-"#,
-    )
-    .unwrap();
+    // The shipped example, as a user runs it.
+    let example = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples/drilled_box.sdf.toml");
+    let drilled = AnalyticSdf::from_toml(&std::fs::read_to_string(example).unwrap()).unwrap();
     let (mesh, _) = reconstruct(Arc::new(drilled), DEFAULT_BOUNDS, 2000, true);
     assert_eq!(mesh.genus(), 1);
 
