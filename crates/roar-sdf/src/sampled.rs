@@ -352,9 +352,8 @@ impl SampledSdf {
     /// The sampled field's value and gradient at `p` (the module's interpolation; outside the
     /// cube, the nearest point's value plus the distance times the median `|∇f|`).
     pub fn eval(&self, p: DVec3) -> (f64, DVec3) {
-        let side = self.fine * f64::from(self.resolution);
-        let q = p.clamp(self.origin, self.origin + DVec3::splat(side));
-        let (value, mut gradient) = self.eval_inside(q);
+        let q = self.nearest_in_cube(p);
+        let (value, mut gradient) = self.interpolate::<true>(q);
         let outside = p - q;
         let distance = outside.length();
         if distance > 0.0 && distance.is_finite() {
@@ -370,21 +369,14 @@ impl SampledSdf {
 
     /// The sampled field's value at `p` (as [`SampledSdf::eval`], without the gradient).
     pub fn value(&self, p: DVec3) -> f64 {
+        let q = self.nearest_in_cube(p);
+        self.interpolate::<false>(q).0 + (p - q).length() * self.median_gradient
+    }
+
+    /// The point of the sampled cube nearest to `p`.
+    fn nearest_in_cube(&self, p: DVec3) -> DVec3 {
         let side = self.fine * f64::from(self.resolution);
-        let q = p.clamp(self.origin, self.origin + DVec3::splat(side));
-        let (cell, base, h) = self.leaf(q);
-        let t = ((q - base) / h).clamp(DVec3::ZERO, DVec3::ONE);
-        let mut value = 0.0;
-        for (c, &index) in cell.corners.iter().enumerate() {
-            let w = (if c & 1 == 1 { t.x } else { 1.0 - t.x })
-                * (if c & 2 == 2 { t.y } else { 1.0 - t.y })
-                * (if c & 4 == 4 { t.z } else { 1.0 - t.z });
-            let x = base + h * DVec3::new((c & 1) as f64, ((c >> 1) & 1) as f64, (c >> 2) as f64);
-            let sample = &self.samples[index as usize];
-            let g = DVec3::from_array(sample.gradient);
-            value += w * (sample.value + 0.5 * g.dot(q - x));
-        }
-        value + (p - q).length() * self.median_gradient
+        p.clamp(self.origin, self.origin + DVec3::splat(side))
     }
 
     /// The leaf holding `p`, a point of the cube, with its lowest corner and side.
@@ -422,8 +414,9 @@ impl SampledSdf {
         (cell, base, h)
     }
 
-    /// The interpolation at `p`, a point of the cube.
-    fn eval_inside(&self, p: DVec3) -> (f64, DVec3) {
+    /// The interpolation at `p`, a point of the cube, with its gradient when `GRADIENT` (zero
+    /// otherwise: the value-only queries skip its cost).
+    fn interpolate<const GRADIENT: bool>(&self, p: DVec3) -> (f64, DVec3) {
         let (cell, base, h) = self.leaf(p);
         let t = ((p - base) / h).clamp(DVec3::ZERO, DVec3::ONE);
         let mut value = 0.0;
@@ -441,17 +434,19 @@ impl SampledSdf {
                 };
             }
             let w = factor[0] * factor[1] * factor[2];
-            let dw = DVec3::new(
-                slope[0] * factor[1] * factor[2],
-                factor[0] * slope[1] * factor[2],
-                factor[0] * factor[1] * slope[2],
-            );
             let x = base + h * DVec3::new(bits[0] as f64, bits[1] as f64, bits[2] as f64);
             let sample = &self.samples[index as usize];
             let g = DVec3::from_array(sample.gradient);
             let local = sample.value + 0.5 * g.dot(p - x);
             value += w * local;
-            gradient += dw * local + 0.5 * w * g;
+            if GRADIENT {
+                let dw = DVec3::new(
+                    slope[0] * factor[1] * factor[2],
+                    factor[0] * slope[1] * factor[2],
+                    factor[0] * factor[1] * slope[2],
+                );
+                gradient += dw * local + 0.5 * w * g;
+            }
         }
         (value, gradient)
     }

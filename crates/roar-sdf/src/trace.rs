@@ -308,9 +308,9 @@ pub fn trace_normal_maps(
         }
         images.push(image);
     }
-    let after = sdf.evaluations();
-    stats.value_evaluations = (after.values - before.values) as usize;
-    stats.gradient_evaluations = (after.gradients - before.gradients) as usize;
+    let counted = sdf.evaluations() - before;
+    stats.value_evaluations = counted.values as usize;
+    stats.gradient_evaluations = counted.gradients as usize;
     stats.seconds = start.elapsed().as_secs_f64();
     (images, stats)
 }

@@ -18,6 +18,17 @@ pub struct SdfEvaluations {
     pub gradients: u64,
 }
 
+/// The points counted between two readings of the counters: `after − before`.
+impl std::ops::Sub for SdfEvaluations {
+    type Output = Self;
+    fn sub(self, before: Self) -> Self {
+        Self {
+            values: self.values - before.values,
+            gradients: self.gradients - before.gradients,
+        }
+    }
+}
+
 /// A signed distance function `f` and its gradient, evaluated for a batch of points at a time.
 ///
 /// Implementations must be deterministic (the same point gives the same bits whatever the

@@ -176,8 +176,8 @@ impl SdfShape {
     fn counted<T>(&self, stage: &'static str, work: impl FnOnce() -> T) -> T {
         let (before, queried) = (self.field.evaluations(), self.queries());
         let out = work();
-        let field = difference(self.field.evaluations(), before);
-        let queries = difference(self.queries(), queried);
+        let field = self.field.evaluations() - before;
+        let queries = self.queries() - queried;
         if let Ok(mut counts) = self.counts.lock() {
             counts.push((stage, field, queries));
         }
@@ -232,33 +232,17 @@ impl SdfShape {
             sample: self.sample_stats,
             ..SdfReport::default()
         };
-        let (total, queried) = (self.field.evaluations(), self.queries());
-        let (mut field, mut queries) = (SdfEvaluations::default(), SdfEvaluations::default());
         if let Ok(counts) = self.counts.lock() {
-            for (stage, e, q) in counts.iter() {
-                *report.values.entry(stage).or_default() += e.values;
-                *report.gradients.entry(stage).or_default() += e.gradients;
-                field.values += e.values;
-                field.gradients += e.gradients;
-                if self.sampled.is_some() {
-                    *report.sampled_values.entry(stage).or_default() += q.values;
-                    *report.sampled_gradients.entry(stage).or_default() += q.gradients;
-                }
-                queries.values += q.values;
-                queries.gradients += q.gradients;
+            (report.values, report.gradients) = by_stage(
+                counts.iter().map(|&(stage, field, _)| (stage, field)),
+                self.field.evaluations(),
+            );
+            if self.sampled.is_some() {
+                (report.sampled_values, report.sampled_gradients) = by_stage(
+                    counts.iter().map(|&(stage, _, queries)| (stage, queries)),
+                    self.queries(),
+                );
             }
-        }
-        report.values.insert("loop", total.values - field.values);
-        report
-            .gradients
-            .insert("loop", total.gradients - field.gradients);
-        if self.sampled.is_some() {
-            report
-                .sampled_values
-                .insert("loop", queried.values - queries.values);
-            report
-                .sampled_gradients
-                .insert("loop", queried.gradients - queries.gradients);
         }
         if let Ok(trace) = self.trace.lock() {
             report.trace_rays = trace.rays;
@@ -365,12 +349,24 @@ impl Shape for SdfShape {
     }
 }
 
-/// `a − b`, counter by counter.
-fn difference(a: SdfEvaluations, b: SdfEvaluations) -> SdfEvaluations {
-    SdfEvaluations {
-        values: a.values - b.values,
-        gradients: a.gradients - b.gradients,
+/// Counts by stage, values and gradients apart, with what no stage claimed of `total` charged
+/// to `loop`.
+fn by_stage<'a>(
+    counts: impl Iterator<Item = (&'a str, SdfEvaluations)>,
+    total: SdfEvaluations,
+) -> (BTreeMap<&'a str, u64>, BTreeMap<&'a str, u64>) {
+    let (mut values, mut gradients) = (BTreeMap::new(), BTreeMap::new());
+    let mut claimed = SdfEvaluations::default();
+    for (stage, e) in counts {
+        *values.entry(stage).or_default() += e.values;
+        *gradients.entry(stage).or_default() += e.gradients;
+        claimed.values += e.values;
+        claimed.gradients += e.gradients;
     }
+    let rest = total - claimed;
+    values.insert("loop", rest.values);
+    gradients.insert("loop", rest.gradients);
+    (values, gradients)
 }
 
 /// The sampling's options from the configuration: `sdf_sample_resolution`, or when it is 0 the
