@@ -1,10 +1,30 @@
 //! Samples a field file (`roar_sdf::SampledSdf`) and prints, as one JSON line, the sampling's
 //! figures and its interpolation error near the zero set, in finest cells:
-//! `cargo run --release -p roar-sdf --example sample_stats -- FIELD [RESOLUTION] [BAND]`.
+//! `cargo run --release -p roar-sdf --example sample_stats -- FIELD [RESOLUTION] [BAND]
+//! [values]`; with `values` the sampler is given values alone and differences its samples (as
+//! for a Python field without a gradient).
 
 use glam::DVec3;
-use roar_mesh::spatial::{Sdf, evaluate_with_gradients, project_to_zero_set};
+use roar_mesh::spatial::{Sdf, SdfEvaluations, evaluate_with_gradients, project_to_zero_set};
 use roar_sdf::{DEFAULT_BOUNDS, SampleOptions, SampledSdf, load_sdf_input};
+
+/// A field seen through its values alone.
+struct ValuesOnly<'a>(&'a dyn Sdf);
+
+impl Sdf for ValuesOnly<'_> {
+    fn values(&self, points: &[DVec3], values: &mut [f64]) {
+        self.0.values(points, values);
+    }
+    fn values_and_gradients(&self, points: &[DVec3], values: &mut [f64], gradients: &mut [DVec3]) {
+        self.0.values_and_gradients(points, values, gradients);
+    }
+    fn evaluations(&self) -> SdfEvaluations {
+        self.0.evaluations()
+    }
+    fn has_gradient(&self) -> bool {
+        false
+    }
+}
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let args: Vec<String> = std::env::args().collect();
@@ -16,7 +36,12 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let input = load_sdf_input(std::path::Path::new(path), DEFAULT_BOUNDS)?;
     let bounds = input.bounds.unwrap_or(DEFAULT_BOUNDS);
     let options = SampleOptions::for_resolution(resolution, band);
-    let (sampled, stats) = SampledSdf::build(input.field.as_ref(), bounds, &options)?;
+    let values_only = args.get(4).is_some_and(|a| a == "values");
+    let (sampled, stats) = if values_only {
+        SampledSdf::build(&ValuesOnly(input.field.as_ref()), bounds, &options)?
+    } else {
+        SampledSdf::build(input.field.as_ref(), bounds, &options)?
+    };
     // Points near the zero set: a regular lattice pulled onto it, then moved off it by up to a
     // finest cell along the normal.
     let fine = bounds.extent().max_element() / resolution as f64;
@@ -62,7 +87,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     angles.sort_by(f64::total_cmp);
     let at = |v: &[f64], q: f64| v[((v.len() - 1) as f64 * q) as usize];
     println!(
-        "{{\"resolution\": {resolution}, \"coarse\": {}, \"band\": {band}, \"field_evaluations\": {}, \"cells\": {}, \"finest_leaves\": {}, \"mb\": {:.1}, \"seconds\": {:.2}, \"median_gradient\": {:.3}, \"error_cells_median\": {:.2e}, \"error_cells_p99\": {:.2e}, \"normal_1mcos_median\": {:.2e}, \"normal_1mcos_p99\": {:.2e}, \"points\": {}, \"seconds_per_million_values\": {:.2}, \"seconds_per_million_gradients\": {:.2}}}",
+        "{{\"values_only\": {values_only}, \"resolution\": {resolution}, \"coarse\": {}, \"band\": {band}, \"field_evaluations\": {}, \"cells\": {}, \"finest_leaves\": {}, \"mb\": {:.1}, \"seconds\": {:.2}, \"median_gradient\": {:.3}, \"error_cells_median\": {:.2e}, \"error_cells_p99\": {:.2e}, \"normal_1mcos_median\": {:.2e}, \"normal_1mcos_p99\": {:.2e}, \"points\": {}, \"seconds_per_million_values\": {:.2}, \"seconds_per_million_gradients\": {:.2}}}",
         options.coarse_resolution,
         stats.field_evaluations,
         stats.cells,

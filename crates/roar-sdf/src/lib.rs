@@ -141,4 +141,8 @@ impl Sdf for RigSdf {
     fn evaluations(&self) -> SdfEvaluations {
         self.inner.evaluations()
     }
+
+    fn has_gradient(&self) -> bool {
+        self.inner.has_gradient()
+    }
 }

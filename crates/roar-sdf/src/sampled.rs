@@ -9,6 +9,12 @@
 //! outside). A split evaluates the 27 corners of its 8 children, sharing the corners already
 //! evaluated, so every lattice point is evaluated once, with its gradient, in batches.
 //!
+//! A field that cannot give its gradient cheaply ([`Sdf::has_gradient`] false: a Python
+//! callable without one) is asked for values alone, and each sample's gradient is the central
+//! difference of its nearest lattice neighbours along each axis (one-sided where only one
+//! exists): at every level for the refinement test, and once more at the end, from the finest
+//! neighbours the octree holds.
+//!
 //! Inside a leaf with corners `xᵢ`, values `fᵢ`, gradients `gᵢ` and trilinear weights `wᵢ(p)`,
 //! the sampled field is `f(p) = Σ wᵢ (fᵢ + ½ gᵢ·(p − xᵢ))`, exact for quadratic fields, and its
 //! gradient is the derivative of that expression. Outside the cube it is the value at the
@@ -112,6 +118,8 @@ pub struct SampleStats {
     pub bytes: usize,
     /// The median `|∇f|` of the samples (the slope outside the cube).
     pub median_gradient: f64,
+    /// Whether the gradients are the field's own; `false`: differences of the samples.
+    pub field_gradients: bool,
     /// Wall time of the sampling.
     pub seconds: f64,
 }
@@ -164,8 +172,12 @@ struct Lattice {
     origin: DVec3,
     fine: f64,
     index: HashMap<u64, u32>,
+    /// Every lattice point met, by sample index.
+    coords: Vec<[u32; 3]>,
     pending: Vec<[u32; 3]>,
     count: u32,
+    /// Cells of the finest level along the cube's side.
+    resolution: u32,
 }
 
 impl Lattice {
@@ -173,20 +185,24 @@ impl Lattice {
     fn corner(&mut self, p: [u32; 3]) -> u32 {
         let count = &mut self.count;
         let pending = &mut self.pending;
+        let coords = &mut self.coords;
         *self.index.entry(key(p)).or_insert_with(|| {
             pending.push(p);
+            coords.push(p);
             *count += 1;
             *count - 1
         })
     }
 
-    /// Evaluates the queued points with `field`, appending to `values` and `gradients`.
+    /// Evaluates the queued points with `field`, appending to `values` and `gradients` (the
+    /// field's, or differences of the samples when it has none).
     fn flush(
         &mut self,
         field: &dyn Sdf,
         values: &mut Vec<f64>,
         gradients: &mut Vec<DVec3>,
     ) -> Result<(), SdfError> {
+        let with_gradient = field.has_gradient();
         let points: Vec<DVec3> = self
             .pending
             .drain(..)
@@ -199,7 +215,13 @@ impl Lattice {
             .par_chunks(BATCH)
             .zip(values[start..].par_chunks_mut(BATCH))
             .zip(gradients[start..].par_chunks_mut(BATCH))
-            .for_each(|((p, v), g)| field.values_and_gradients(p, v, g));
+            .for_each(|((p, v), g)| {
+                if with_gradient {
+                    field.values_and_gradients(p, v, g);
+                } else {
+                    field.values(p, v);
+                }
+            });
         let bad =
             (start..values.len()).find(|&i| !values[i].is_finite() || !gradients[i].is_finite());
         if let Some(i) = bad {
@@ -210,7 +232,47 @@ impl Lattice {
                 points[i - start]
             )));
         }
+        if !with_gradient {
+            self.difference_gradients(start, values, gradients);
+        }
         Ok(())
+    }
+
+    /// Sets the gradients of the samples from `first` on to differences of their nearest
+    /// lattice neighbours: per axis, the smallest spacing `2^k` with a neighbour at `±2^k`;
+    /// central when both exist, one-sided when one does.
+    fn difference_gradients(&self, first: usize, values: &[f64], gradients: &mut [DVec3]) {
+        let neighbour = |p: [u32; 3], axis: usize, offset: i64| {
+            let c = i64::from(p[axis]) + offset;
+            if c < 0 || c > i64::from(self.resolution) {
+                return None;
+            }
+            let mut q = p;
+            q[axis] = c as u32;
+            self.index.get(&key(q)).map(|&i| values[i as usize])
+        };
+        gradients[first..]
+            .par_iter_mut()
+            .zip(&self.coords[first..])
+            .enumerate()
+            .for_each(|(n, (g, &p))| {
+                let f = values[first + n];
+                for axis in 0..3 {
+                    let mut spacing = 1i64;
+                    g[axis] = loop {
+                        if spacing > i64::from(self.resolution) {
+                            break 0.0;
+                        }
+                        let h = spacing as f64 * self.fine;
+                        match (neighbour(p, axis, -spacing), neighbour(p, axis, spacing)) {
+                            (Some(a), Some(b)) => break (b - a) / (2.0 * h),
+                            (Some(a), None) => break (f - a) / h,
+                            (None, Some(b)) => break (b - f) / h,
+                            (None, None) => spacing *= 2,
+                        }
+                    };
+                }
+            });
     }
 }
 
@@ -242,8 +304,10 @@ impl SampledSdf {
             origin,
             fine,
             index: HashMap::new(),
+            coords: Vec::new(),
             pending: Vec::new(),
             count: 0,
+            resolution,
         };
         let (mut values, mut gradients) = (Vec::new(), Vec::new());
         // The coarse grid: every corner, then the root cells.
@@ -305,6 +369,11 @@ impl SampledSdf {
             lattice.flush(field, &mut values, &mut gradients)?;
             level = next;
         }
+        let field_gradients = field.has_gradient();
+        if !field_gradients {
+            // Every sample's differences again, now from the finest neighbours.
+            lattice.difference_gradients(0, &values, &mut gradients);
+        }
         // The last level's cells are the finest ones.
         let finest_leaves = level.len();
         let mut slopes: Vec<f64> = gradients.iter().map(|g| g.length()).collect();
@@ -338,6 +407,7 @@ impl SampledSdf {
             finest_leaves,
             bytes: sampled.bytes(),
             median_gradient,
+            field_gradients,
             seconds: started.elapsed().as_secs_f64(),
         };
         Ok((sampled, stats))
@@ -559,6 +629,25 @@ mod tests {
         }
     }
 
+    /// A field of values alone ([`Sdf::has_gradient`] false), as a Python callable without
+    /// a gradient is: asking it for a gradient is a bug.
+    struct ValuesOnly<F>(FnSdf<F>);
+
+    impl<F: Fn(DVec3) -> f64 + Send + Sync> Sdf for ValuesOnly<F> {
+        fn values(&self, points: &[DVec3], values: &mut [f64]) {
+            self.0.values(points, values);
+        }
+        fn values_and_gradients(&self, _: &[DVec3], _: &mut [f64], _: &mut [DVec3]) {
+            unreachable!("the sampler asked a field without a gradient for one");
+        }
+        fn evaluations(&self) -> SdfEvaluations {
+            self.0.evaluations()
+        }
+        fn has_gradient(&self) -> bool {
+            false
+        }
+    }
+
     fn options(resolution: usize, coarse: usize) -> SampleOptions {
         SampleOptions {
             resolution,
@@ -643,6 +732,51 @@ mod tests {
         let (sampled, stats) = SampledSdf::build(&plate, cube(1.0), &options(128, 8)).unwrap();
         assert!(stats.finest_leaves > 0);
         // Inside the plate the sampled field is negative, above and below positive.
+        for p in points(200, 0.9) {
+            let inside = DVec3::new(p.x, p.y, 0.013);
+            assert!(sampled.eval(inside).0 < 0.0, "{inside}");
+            let above = DVec3::new(p.x, p.y, 0.05);
+            assert!(sampled.eval(above).0 > 0.0, "{above}");
+        }
+    }
+
+    #[test]
+    fn without_the_fields_gradient_the_samples_are_differenced() {
+        let field = ValuesOnly(FnSdf::new(sphere));
+        let (sampled, stats) = SampledSdf::build(&field, cube(1.0), &options(128, 16)).unwrap();
+        assert!(!stats.field_gradients);
+        let counted = field.evaluations();
+        assert_eq!(
+            (counted.values, counted.gradients),
+            (stats.field_evaluations as u64, 0)
+        );
+        // As many points as with the field's gradient: the differences cost no evaluation.
+        let (_, with_gradient) =
+            SampledSdf::build(&Sphere::new(1.0), cube(1.0), &options(128, 16)).unwrap();
+        let ratio = stats.field_evaluations as f64 / with_gradient.field_evaluations as f64;
+        assert!((0.8..1.25).contains(&ratio), "{ratio}");
+        let cell = 2.0 / 128.0;
+        for p in points(3000, 1.0) {
+            let p = p.normalize_or_zero() * (0.6 + 0.01 * p.x);
+            let (f, g) = sampled.eval(p);
+            assert!(
+                (f - sphere(p)).abs() < 0.05 * cell,
+                "{p}: error {}",
+                f - sphere(p)
+            );
+            let normal = p.normalize();
+            assert!(
+                (g - normal).length() < 0.02,
+                "{p}: gradient {g} against {normal}"
+            );
+        }
+    }
+
+    #[test]
+    fn without_the_fields_gradient_refinement_still_finds_a_thin_plate() {
+        let plate = ValuesOnly(FnSdf::new(|p: DVec3| (p.z - 0.013).abs() - 0.01));
+        let (sampled, stats) = SampledSdf::build(&plate, cube(1.0), &options(128, 8)).unwrap();
+        assert!(stats.finest_leaves > 0);
         for p in points(200, 0.9) {
             let inside = DVec3::new(p.x, p.y, 0.013);
             assert!(sampled.eval(inside).0 < 0.0, "{inside}");

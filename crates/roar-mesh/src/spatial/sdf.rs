@@ -44,6 +44,13 @@ pub trait Sdf: Send + Sync {
 
     /// The points evaluated so far.
     fn evaluations(&self) -> SdfEvaluations;
+
+    /// Whether [`Sdf::values_and_gradients`] evaluates the field's own gradient. `false` when it
+    /// can only difference values (several evaluations a point): a sampler then asks for values
+    /// alone and differences its own samples.
+    fn has_gradient(&self) -> bool {
+        true
+    }
 }
 
 /// Thread-safe counters of evaluated points, for [`Sdf`] implementations.
