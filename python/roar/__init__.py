@@ -25,6 +25,7 @@ __all__ = [
     "RoarError",
     "reconstruct",
     "reconstruct_file",
+    "reconstruct_sdf",
     "read_mesh",
     "eval",
     "decimate",
@@ -123,6 +124,104 @@ def _reconstruct(v, f, faces_wanted, config, progress, label):
         raise ValueError("progress must be callable")
     p, t, report = _roar.reconstruct(
         v, f, faces_wanted, _config_json(config), label, progress
+    )
+    out_v, out_f = _arrays(p, t)
+    return out_v, out_f, json.loads(report)
+
+
+class _Field:
+    """The user's field as the compiled half calls it: ``(bytes of (n, 3) <f8 points,
+    with_gradient) -> bytes`` of the n values (then the (n, 3) gradients), every result checked.
+    Batches are numbered from 0 in the order they are asked for."""
+
+    def __init__(self, f: Callable[[np.ndarray], Any], gradient: Optional[Callable]):
+        self.f = f
+        self.gradient = gradient
+        self.batch = 0
+
+    def __call__(self, data: bytes, with_gradient: bool) -> bytes:
+        # A writable copy, so torch.from_numpy and in-place user code work.
+        points = np.frombuffer(data, dtype="<f8").reshape(-1, 3).copy()
+        batch = self.batch
+        self.batch += 1
+        n = len(points)
+        values = self._checked("f", self.f(points), (n,), batch, points)
+        if not with_gradient:
+            return values.tobytes()
+        gradients = self._checked("gradient", self.gradient(points), (n, 3), batch, points)
+        return values.tobytes() + gradients.tobytes()
+
+    @staticmethod
+    def _checked(name, returned, shape, batch, points) -> np.ndarray:
+        where = f"{name}: batch {batch} ({len(points)} points)"
+        try:
+            a = np.asarray(returned, dtype=np.float64)
+        except (TypeError, ValueError) as e:
+            raise ValueError(f"{where}: cannot read the result as float64: {e}") from None
+        if a.shape != shape and not (len(shape) == 1 and a.shape == (shape[0], 1)):
+            want = f"({shape[0]},)" if len(shape) == 1 else f"({shape[0]}, 3)"
+            raise ValueError(f"{where}: returned shape {a.shape}, expected {want}")
+        if not np.all(np.isfinite(a)):
+            row = int(np.argwhere(~np.isfinite(a.reshape(shape[0], -1)))[0][0])
+            raise ValueError(
+                f"{where}: not finite at point {row} {tuple(points[row].tolist())}"
+            )
+        return np.ascontiguousarray(a.reshape(shape), dtype="<f8")
+
+
+def _bounds(bounds: Any) -> Tuple[Tuple[float, ...], Tuple[float, ...]]:
+    try:
+        b = np.asarray(bounds, dtype=np.float64)
+    except (TypeError, ValueError):
+        b = None
+    if b is None or b.shape != (2, 3):
+        raise ValueError(f"bounds must be ((xmin, ymin, zmin), (xmax, ymax, zmax)), not {bounds!r}")
+    if not np.all(np.isfinite(b)) or not np.all(b[1] > b[0]):
+        raise ValueError(f"bounds must be finite with max > min on every axis, not {b.tolist()}")
+    return tuple(b[0].tolist()), tuple(b[1].tolist())
+
+
+def reconstruct_sdf(
+    f: Callable[[np.ndarray], Any],
+    bounds: Any,
+    target_faces: int,
+    gradient: Optional[Callable[[np.ndarray], Any]] = None,
+    config: Optional[Dict[str, Any]] = None,
+    progress: Optional[Callable[[Dict[str, Any]], None]] = None,
+) -> Tuple[np.ndarray, np.ndarray, Dict[str, Any]]:
+    """Reconstructs the zero set of a signed distance function (negative inside) within
+    ``bounds = ((xmin, ymin, zmin), (xmax, ymax, zmax))`` as a closed, oriented 2-manifold with
+    exactly ``target_faces`` faces, with the CLI's SDF schedule.
+
+    ``f`` maps a float64 ``(n, 3)`` array to ``n`` values (anything ``np.asarray`` reads: wrap a
+    PyTorch or JAX model in a line, e.g. ``lambda p: model(torch.from_numpy(p)).detach().numpy()``).
+    roar samples the field once, adaptively, calling ``f`` on batches of up to 16,384 points,
+    one at a time; every later stage reads the samples. ``gradient``, if given, maps the same
+    array to the ``(n, 3)`` gradients; without it, gradients are differences of the samples (no
+    extra calls). The field need not be distance-scaled.
+
+    An exception raised by ``f``, ``gradient`` or ``progress`` propagates as itself; a result of
+    the wrong shape, or one that is not finite, is a ``ValueError`` naming the batch and point.
+    Ctrl-C takes effect at the next progress report (the sampling is one stage).
+
+    Returns ``(vertices, faces, report)``; ``report["sdf"]`` counts the field's evaluations by
+    stage (``values``, ``gradients``) and the sampling's figures.
+    """
+    if not callable(f):
+        raise ValueError("f must be callable")
+    if gradient is not None and not callable(gradient):
+        raise ValueError("gradient must be callable")
+    if progress is not None and not callable(progress):
+        raise ValueError("progress must be callable")
+    lo, hi = _bounds(bounds)
+    faces_wanted = _budget(target_faces)
+    p, t, report = _roar.reconstruct_sdf(
+        _Field(f, gradient),
+        gradient is not None,
+        (lo, hi),
+        faces_wanted,
+        _config_json(config),
+        progress,
     )
     out_v, out_f = _arrays(p, t)
     return out_v, out_f, json.loads(report)

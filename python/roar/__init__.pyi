@@ -26,6 +26,14 @@ def reconstruct_file(
     progress: Optional[_Progress] = None,
     output: Optional[_Path] = None,
 ) -> Tuple[npt.NDArray[np.float64], npt.NDArray[np.int64], Dict[str, Any]]: ...
+def reconstruct_sdf(
+    f: Callable[[npt.NDArray[np.float64]], npt.ArrayLike],
+    bounds: npt.ArrayLike,
+    target_faces: int,
+    gradient: Optional[Callable[[npt.NDArray[np.float64]], npt.ArrayLike]] = None,
+    config: Optional[Dict[str, Any]] = None,
+    progress: Optional[_Progress] = None,
+) -> Tuple[npt.NDArray[np.float64], npt.NDArray[np.int64], Dict[str, Any]]: ...
 def read_mesh(path: _Path) -> Tuple[npt.NDArray[np.float64], npt.NDArray[np.int64]]: ...
 def eval(
     vertices: npt.ArrayLike,

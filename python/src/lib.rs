@@ -8,18 +8,19 @@
 //! the progress check stopped the run.
 
 use std::path::PathBuf;
-use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::{Arc, Mutex};
 
 use glam::DVec3;
 use pyo3::create_exception;
 use pyo3::exceptions::{PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyBytes, PyDict};
-use roar::{PipelineError, Progress, ReconstructConfig, Reconstruction, SoupShape};
+use roar::{PipelineError, Progress, ReconstructConfig, Reconstruction, SdfShape, SoupShape};
 use roar_eval::{EvalError, EvalOptions};
 use roar_io::TriangleSoup;
 use roar_mesh::Mesh;
+use roar_mesh::spatial::{Aabb, Sdf, SdfCounter, SdfEvaluations};
 
 create_exception!(
     _roar,
@@ -79,12 +80,15 @@ fn config_error(e: impl std::fmt::Display) -> PyErr {
     PyValueError::new_err(format!("config: {e}"))
 }
 
-/// The effective config: defaults, then the JSON of the user's dict (the CLI's TOML layout),
+/// The effective config: `defaults`, then the JSON of the user's dict (the CLI's TOML layout),
 /// then the face budget; validated like the CLI's.
-fn effective_config(config_json: &str, faces: usize) -> PyResult<ReconstructConfig> {
+fn effective_config(
+    config_json: &str,
+    faces: usize,
+    defaults: &ReconstructConfig,
+) -> PyResult<ReconstructConfig> {
     let table: toml::Table = serde_json::from_str(config_json).map_err(config_error)?;
-    let mut config = ReconstructConfig::from_table(table, &ReconstructConfig::default())
-        .map_err(config_error)?;
+    let mut config = ReconstructConfig::from_table(table, defaults).map_err(config_error)?;
     config.faces = faces;
     config.validate().map_err(config_error)?;
     Ok(config)
@@ -104,8 +108,167 @@ fn reconstruct<'py>(
     progress: Option<Py<PyAny>>,
 ) -> PyResult<(Bound<'py, PyBytes>, Bound<'py, PyBytes>, String)> {
     let soup = soup_from_bytes(positions, triangles)?;
-    let config = effective_config(config_json, faces)?;
+    let config = effective_config(config_json, faces, &ReconstructConfig::default())?;
     run_reconstruction(py, &soup, config, label, progress)
+}
+
+/// A field given by the Python half's `field(points, with_gradient)`, which calls the user's
+/// callables on the `<f8` bytes of `(n, 3)` points, checks what they return and gives back the
+/// bytes of `n` values (then `3n` gradient components when asked).
+struct PyField {
+    call: Py<PyAny>,
+    /// Whether the user gave a gradient; without one, the sampler differences its samples.
+    has_gradient: bool,
+    /// Central-difference step of a gradient asked of a field without one (only when the field
+    /// is not sampled: `sdf_sample = false`).
+    step: f64,
+    counter: SdfCounter,
+    /// The first exception the callables raised. Calls are made one at a time (under this
+    /// lock); after an exception no batch is sent and every value reads NaN, which stops the run.
+    error: Mutex<Option<PyErr>>,
+}
+
+impl PyField {
+    /// Fills `values` (and `gradients` when given) at `points` by one call of the Python half.
+    fn call(&self, points: &[DVec3], values: &mut [f64], gradients: Option<&mut [DVec3]>) {
+        let mut error = self.error.lock().unwrap_or_else(|e| e.into_inner());
+        if error.is_none() {
+            let with_gradient = gradients.is_some();
+            let bytes: Vec<u8> = points
+                .iter()
+                .flat_map(|p| p.to_array())
+                .flat_map(f64::to_le_bytes)
+                .collect();
+            let returned = Python::attach(|py| -> PyResult<Vec<f64>> {
+                let out = self
+                    .call
+                    .call1(py, (PyBytes::new(py, &bytes), with_gradient))?;
+                let out = out.bind(py).cast::<PyBytes>()?.as_bytes().to_vec();
+                Ok(out
+                    .chunks_exact(8)
+                    .map(|c| f64::from_le_bytes(c.try_into().expect("8-byte chunk")))
+                    .collect())
+            });
+            let n = points.len();
+            match returned {
+                Ok(out) if out.len() == if with_gradient { 4 * n } else { n } => {
+                    values.copy_from_slice(&out[..n]);
+                    if let Some(gradients) = gradients {
+                        for (i, g) in gradients.iter_mut().enumerate() {
+                            *g = DVec3::new(out[n + 3 * i], out[n + 3 * i + 1], out[n + 3 * i + 2]);
+                        }
+                    }
+                    return;
+                }
+                Ok(out) => {
+                    *error = Some(PyRuntimeError::new_err(format!(
+                        "internal: the field gave {} numbers for {n} points",
+                        out.len()
+                    )))
+                }
+                Err(e) => *error = Some(e),
+            }
+        }
+        values.fill(f64::NAN);
+    }
+}
+
+impl Sdf for PyField {
+    fn values(&self, points: &[DVec3], values: &mut [f64]) {
+        self.counter.add_values(points.len());
+        self.call(points, values, None);
+    }
+
+    fn values_and_gradients(&self, points: &[DVec3], values: &mut [f64], gradients: &mut [DVec3]) {
+        if self.has_gradient {
+            self.counter.add_gradients(points.len());
+            self.call(points, values, Some(gradients));
+            return;
+        }
+        // The points, then their six neighbours at ±step along each axis, in one call.
+        let h = self.step;
+        let mut all = points.to_vec();
+        for e in [DVec3::X, DVec3::Y, DVec3::Z] {
+            all.extend(points.iter().map(|p| *p + h * e));
+            all.extend(points.iter().map(|p| *p - h * e));
+        }
+        let mut out = vec![0.0; all.len()];
+        self.values(&all, &mut out);
+        let n = points.len();
+        values.copy_from_slice(&out[..n]);
+        for (i, g) in gradients.iter_mut().enumerate() {
+            let d = |axis: usize| {
+                (out[n * (1 + 2 * axis) + i] - out[n * (2 + 2 * axis) + i]) / (2.0 * h)
+            };
+            *g = DVec3::new(d(0), d(1), d(2));
+        }
+    }
+
+    fn evaluations(&self) -> SdfEvaluations {
+        self.counter.get()
+    }
+
+    fn has_gradient(&self) -> bool {
+        self.has_gradient
+    }
+}
+
+/// Reconstructs the zero set of a Python field inside `bounds` (`(min, max)`, checked by the
+/// Python half) and returns `(positions, triangles, report_json)`. `field` is the Python
+/// half's checked caller of the user's callables ([`PyField`]); an exception of theirs wins
+/// over the pipeline's error.
+#[pyfunction]
+#[pyo3(signature = (field, has_gradient, bounds, faces, config_json, progress=None))]
+fn reconstruct_sdf<'py>(
+    py: Python<'py>,
+    field: Py<PyAny>,
+    has_gradient: bool,
+    bounds: ([f64; 3], [f64; 3]),
+    faces: usize,
+    config_json: &str,
+    progress: Option<Py<PyAny>>,
+) -> PyResult<(Bound<'py, PyBytes>, Bound<'py, PyBytes>, String)> {
+    let config = effective_config(config_json, faces, &ReconstructConfig::sdf_defaults())?;
+    let bounds = Aabb {
+        min: DVec3::from_array(bounds.0),
+        max: DVec3::from_array(bounds.1),
+    };
+    let field = Arc::new(PyField {
+        call: field,
+        has_gradient,
+        step: 1e-6 * bounds.diagonal(),
+        counter: SdfCounter::default(),
+        error: Mutex::new(None),
+    });
+    let label = "<function>";
+    let started = std::time::Instant::now();
+    let outcome = with_progress(py, &config, progress, |reconstruction, on_progress| {
+        let mut shape = SdfShape::new(label, field.clone(), bounds, &config);
+        let result = reconstruction.run(&mut shape, on_progress)?;
+        let output_metrics = roar_eval::evaluate(
+            &result.positions,
+            &result.triangles,
+            None,
+            &EvalOptions::default(),
+        )?;
+        Ok::<_, RunError>((result, shape.report(), output_metrics))
+    })?;
+    if let Some(e) = field.error.lock().unwrap_or_else(|e| e.into_inner()).take() {
+        return Err(e);
+    }
+    let (result, sdf, output_metrics) =
+        outcome.map_err(|e| roar_error(format!("{label}: reconstruction failed: {e}")))?;
+    let report = serde_json::json!({
+        "input": label,
+        "seed": config.seed,
+        "seconds_total": started.elapsed().as_secs_f64(),
+        "output_metrics": output_metrics,
+        "run": result.stats,
+        "config": config,
+        "sdf": sdf,
+    });
+    let (p, t) = soup_to_bytes(py, &result.positions, &result.triangles);
+    Ok((p, t, report.to_string()))
 }
 
 /// Reads a mesh file of any format the CLI reads (OBJ, PLY, STL, OFF, glTF) and returns
@@ -158,16 +321,17 @@ impl std::fmt::Display for RunError {
     }
 }
 
-fn run_reconstruction<'py>(
-    py: Python<'py>,
-    soup: &TriangleSoup,
-    config: ReconstructConfig,
-    label: &str,
+/// Runs `work` on a [`Reconstruction`] of `config` with the GIL released, calling the user's
+/// `progress` and checking for Ctrl-C at every report; the first exception of either stops the
+/// run and is returned as the error, else `work`'s result.
+fn with_progress<T: Send>(
+    py: Python<'_>,
+    config: &ReconstructConfig,
     progress: Option<Py<PyAny>>,
-) -> PyResult<(Bound<'py, PyBytes>, Bound<'py, PyBytes>, String)> {
+    work: impl FnOnce(&mut Reconstruction, &mut dyn FnMut(&Progress)) -> T + Send,
+) -> PyResult<T> {
     let cancel = Arc::new(AtomicBool::new(false));
     let mut stopped_by: Option<PyErr> = None;
-    let started = std::time::Instant::now();
     let outcome = py.detach(|| {
         let mut reconstruction = Reconstruction::new(config.clone());
         reconstruction.cancel = Some(cancel.clone());
@@ -193,8 +357,25 @@ fn run_reconstruction<'py>(
                 cancel.store(true, Ordering::Relaxed);
             }
         };
+        work(&mut reconstruction, &mut on_progress)
+    });
+    match stopped_by {
+        Some(e) => Err(e),
+        None => Ok(outcome),
+    }
+}
+
+fn run_reconstruction<'py>(
+    py: Python<'py>,
+    soup: &TriangleSoup,
+    config: ReconstructConfig,
+    label: &str,
+    progress: Option<Py<PyAny>>,
+) -> PyResult<(Bound<'py, PyBytes>, Bound<'py, PyBytes>, String)> {
+    let started = std::time::Instant::now();
+    let outcome = with_progress(py, &config, progress, |reconstruction, on_progress| {
         let mut shape = SoupShape::new(label, &soup.positions, &soup.triangles, &config);
-        let result = reconstruction.run(&mut shape, &mut on_progress)?;
+        let result = reconstruction.run(&mut shape, on_progress)?;
         drop(shape);
         let eval_input = EvalOptions {
             self_intersections: None,
@@ -209,10 +390,7 @@ fn run_reconstruction<'py>(
             &EvalOptions::default(),
         )?;
         Ok::<_, RunError>((result, input_metrics, output_metrics))
-    });
-    if let Some(e) = stopped_by {
-        return Err(e);
-    }
+    })?;
     let (result, input_metrics, output_metrics) =
         outcome.map_err(|e| roar_error(format!("{label}: reconstruction failed: {e}")))?;
     let report = serde_json::json!({
@@ -333,6 +511,7 @@ fn default_config() -> PyResult<String> {
 fn _roar(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("RoarError", m.py().get_type::<RoarError>())?;
     m.add_function(wrap_pyfunction!(reconstruct, m)?)?;
+    m.add_function(wrap_pyfunction!(reconstruct_sdf, m)?)?;
     m.add_function(wrap_pyfunction!(read_mesh, m)?)?;
     m.add_function(wrap_pyfunction!(write_mesh, m)?)?;
     m.add_function(wrap_pyfunction!(eval, m)?)?;

@@ -244,3 +244,160 @@ def test_dask_map_over_files_on_a_local_cluster(tmp_path):
     for v, f, _ in results:
         assert f.shape == (200, 3)
         assert trimesh.Trimesh(v, f, process=False).is_watertight
+
+
+# Toy settings of the SDF schedule (as the Rust SDF tests use), with the SDF loss on halfway.
+SDF_TOY = {
+    "target": dict(TOY["target"], sdf_trace_grid=64),
+    "loss": dict(TOY["loss"], sdf_loss_start=15),
+    "optimize": dict(TOY["optimize"], iterations=30),
+}
+# The field evaluations a run may spend: marching cubes 128³'s count.
+EVALUATION_CAP = 2_100_000
+TORUS_BOUNDS = ((-0.8, -0.8, -0.35), (0.8, 0.8, 0.35))
+
+
+def torus(p):
+    """The exact signed distance of a torus (radii 0.5 and 0.2) about z, genus 1."""
+    ring = np.hypot(p[:, 0], p[:, 1]) - 0.5
+    return np.hypot(ring, p[:, 2]) - 0.2
+
+
+def torus_gradient(p):
+    xy = np.maximum(np.hypot(p[:, 0], p[:, 1]), 1e-12)
+    ring = xy - 0.5
+    d = np.maximum(np.hypot(ring, p[:, 2]), 1e-12)
+    return np.stack([ring / d * p[:, 0] / xy, ring / d * p[:, 1] / xy, p[:, 2] / d], axis=1)
+
+
+class Mlp:
+    """A bumpy sphere: |p| − 0.5 plus 0.05 × a 3→32→32→1 tanh network with fixed random
+    weights, and its gradient by backpropagation, both in numpy."""
+
+    def __init__(self, seed=3):
+        rng = np.random.default_rng(seed)
+        self.w1, self.b1 = rng.normal(0, 2.0, (3, 32)), rng.normal(0, 0.5, 32)
+        self.w2, self.b2 = rng.normal(0, 0.3, (32, 32)), rng.normal(0, 0.5, 32)
+        self.w3 = rng.normal(0, 0.3, 32)
+
+    def _forward(self, p):
+        h1 = np.tanh(p @ self.w1 + self.b1)
+        h2 = np.tanh(h1 @ self.w2 + self.b2)
+        return h1, h2, np.tanh(h2 @ self.w3)
+
+    def __call__(self, p):
+        return np.linalg.norm(p, axis=1) - 0.5 + 0.05 * self._forward(p)[2]
+
+    def gradient(self, p):
+        h1, h2, out = self._forward(p)
+        d2 = np.outer(1 - out**2, self.w3) * (1 - h2**2)
+        d1 = (d2 @ self.w2.T) * (1 - h1**2)
+        radial = p / np.maximum(np.linalg.norm(p, axis=1, keepdims=True), 1e-12)
+        return radial + 0.05 * d1 @ self.w1.T
+
+
+def field_evaluations(report):
+    sdf = report["sdf"]
+    return sum(sdf["values"].values()) + sum(sdf["gradients"].values())
+
+
+def check_closed_output(v, f, faces):
+    assert f.shape == (faces, 3)
+    metrics = roar.eval(v, f)
+    assert metrics["self_intersections"]["faces"] == 0
+    return trimesh.Trimesh(v, f, process=False)
+
+
+def test_mlp_gradient_matches_finite_differences():
+    mlp = Mlp()
+    p = np.random.default_rng(0).uniform(-0.7, 0.7, (50, 3))
+    h = 1e-6
+    fd = np.stack(
+        [(mlp(p + h * e) - mlp(p - h * e)) / (2 * h) for e in np.eye(3)], axis=1
+    )
+    assert np.allclose(mlp.gradient(p), fd, atol=1e-6)
+
+
+def test_reconstruct_sdf_of_a_numpy_function_without_gradient():
+    batches = []
+
+    def f(p):
+        batches.append(len(p))
+        return torus(p)
+
+    v, faces, report = roar.reconstruct_sdf(f, TORUS_BOUNDS, 1000, config=SDF_TOY)
+    mesh = check_closed_output(v, faces, 1000)
+    assert mesh.is_watertight and mesh.is_winding_consistent
+    assert mesh.euler_number == 0  # genus 1
+    # Only the sampling calls the field, for values alone, in batches of at most 16,384.
+    sdf = report["sdf"]
+    assert set(k for k, n in sdf["values"].items() if n) == {"sample"}
+    assert sum(sdf["gradients"].values()) == 0
+    assert sum(batches) == field_evaluations(report) <= EVALUATION_CAP
+    assert max(batches) <= 16384
+    assert report["sdf"]["sample"]["field_gradients"] is False
+    # The output lies on the zero set (the toy schedule's 15 iterations of SDF loss: within
+    # 2.5 % of the tube's radius), as close as with the field's own gradient.
+    off = np.abs(torus(v)).mean()
+    assert off < 0.005
+    v, _, report = roar.reconstruct_sdf(
+        torus, TORUS_BOUNDS, 1000, gradient=torus_gradient, config=SDF_TOY
+    )
+    assert report["sdf"]["sample"]["field_gradients"] is True
+    assert off < 1.25 * np.abs(torus(v)).mean()
+
+
+def test_reconstruct_sdf_of_a_numpy_mlp_with_its_gradient():
+    mlp = Mlp()
+    bounds = ((-0.75,) * 3, (0.75,) * 3)
+    v, faces, report = roar.reconstruct_sdf(
+        mlp, bounds, 1000, gradient=mlp.gradient, config=SDF_TOY
+    )
+    mesh = check_closed_output(v, faces, 1000)
+    assert mesh.is_watertight and mesh.euler_number == 2
+    sdf = report["sdf"]
+    assert sum(sdf["values"].values()) == 0
+    assert 0 < field_evaluations(report) <= EVALUATION_CAP
+    assert report["sdf"]["sample"]["field_gradients"] is True
+    first_order = np.abs(mlp(v)) / np.linalg.norm(mlp.gradient(v), axis=1)
+    assert first_order.mean() < 0.005
+
+
+class FieldBroke(Exception):
+    pass
+
+
+@pytest.mark.parametrize(
+    "f, error, message",
+    [
+        (lambda p: (_ for _ in ()).throw(FieldBroke("inside f")), FieldBroke, "inside f"),
+        (lambda p: torus(p)[:-1], ValueError, r"f: batch 0 \(\d+ points\): returned shape"),
+        (
+            lambda p: np.where(p[:, 0] > 0.7, np.nan, torus(p)),
+            ValueError,
+            r"f: batch \d+ \(\d+ points\): not finite at point \d+",
+        ),
+        (lambda p: ["x"] * len(p), ValueError, "cannot read the result as float64"),
+    ],
+)
+def test_errors_of_the_field_are_raised_as_themselves_or_name_the_batch(f, error, message):
+    with pytest.raises(error, match=message):
+        roar.reconstruct_sdf(f, TORUS_BOUNDS, 1000, config=SDF_TOY)
+
+
+def test_a_wrong_gradient_shape_names_the_batch():
+    with pytest.raises(ValueError, match=r"gradient: batch 0 .* expected \(\d+, 3\)"):
+        roar.reconstruct_sdf(
+            torus, TORUS_BOUNDS, 1000, gradient=lambda p: p[:, :2], config=SDF_TOY
+        )
+
+
+@pytest.mark.parametrize(
+    "bounds",
+    [((0, 0, 0), (1, 1)), ((0, 0, 0), (1, 0, 1)), ((0, 0, np.nan), (1, 1, 1)), "box"],
+)
+def test_bad_bounds_raise_value_error_before_any_call(bounds):
+    calls = []
+    with pytest.raises(ValueError, match="bounds"):
+        roar.reconstruct_sdf(lambda p: calls.append(1) or torus(p), bounds, 1000)
+    assert calls == []
