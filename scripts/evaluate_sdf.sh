@@ -3,8 +3,9 @@
 # budget and, at every grid resolution, `roar extract` (marching tetrahedra) decimated to the
 # budget by `roar decimate` (roar's QEM). Every output is measured by `roar eval --ref` against
 # the reference surface, the marching extraction of the same field at the reference resolution;
-# the table gives the field's evaluations (values and gradients), seconds, peak memory, Chamfer/
-# diag and normal cosine. Writes DIR/table.md and DIR/results.json.
+# the table gives the field's evaluations (values and gradients), seconds, peak memory, the
+# floor-free Chamfer/diag and normal cosine (exact closest points), and the sampled Chamfer/diag
+# beside it. Writes DIR/table.md and DIR/results.json.
 #
 #   scripts/evaluate_sdf.sh [--fields "A.npz B.npz"] [--budgets "5000 50000"]
 #       [--resolutions "32 64 128 256 512"] [--reference 512] [--samples 1000000] [--config FILE]
@@ -40,7 +41,7 @@ while [ $# -gt 0 ]; do
     --config) config="$2"; shift 2 ;;
     --meshlab) meshlab=1; shift ;;
     --out) out="$2"; shift 2 ;;
-    -h|--help) sed -n '2,19p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    -h|--help) sed -n '2,20p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
     *) echo "evaluate_sdf.sh: unknown argument $1" >&2; exit 2 ;;
   esac
 done

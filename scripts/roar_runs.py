@@ -41,4 +41,6 @@ def evaluate(roar, mesh, ref, samples=None):
         "signed_volume": (r.get("orientation") or {}).get("signed_volume"),
         "chamfer_over_diag": r["fidelity"]["chamfer_l2_over_diag"],
         "normal_cosine": r["fidelity"]["normal_cosine"],
+        "chamfer_exact_over_diag": r["fidelity"]["chamfer_exact_over_diag"],
+        "normal_cosine_exact": r["fidelity"]["normal_cosine_exact"],
     }
