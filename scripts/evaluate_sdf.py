@@ -74,16 +74,20 @@ def main():
     p.add_argument("--budgets", nargs="+", type=int, required=True)
     p.add_argument("--resolutions", nargs="+", type=int, required=True)
     p.add_argument("--reference", type=int, required=True)
+    p.add_argument("--refs", nargs="*", default=[],
+                   help="reference meshes, one per field, in place of the fields' extractions")
     p.add_argument("--config", default="")
     p.add_argument("--bounds", default="")
     p.add_argument("--samples", type=int, required=True)
     p.add_argument("--meshlab", default="", help="a python with pymeshlab: adds MeshLab QEM rows")
     p.add_argument("--out", required=True)
     a = p.parse_args()
+    if a.refs and len(a.refs) != len(a.fields):
+        sys.exit("evaluate_sdf: --refs needs one mesh per field")
     rows = []
-    for field in a.fields:
+    for k, field in enumerate(a.fields):
         name = os.path.basename(field).split(".")[0]
-        ref = os.path.join(a.out, "%s-mt-%d.obj" % (name, a.reference))
+        ref = a.refs[k] if a.refs else os.path.join(a.out, "%s-mt-%d.obj" % (name, a.reference))
         if not os.path.exists(ref):
             info = extract(a.roar, field, ref, a.reference, a.bounds)
             print("%s: reference %d³ %.0f s, %d faces" % (name, a.reference, info["seconds"], info["faces"]),

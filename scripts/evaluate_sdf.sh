@@ -9,13 +9,15 @@
 #
 #   scripts/evaluate_sdf.sh [--fields "A.npz B.npz"] [--budgets "5000 50000"]
 #       [--resolutions "32 64 128 256 512"] [--reference 512] [--samples 1000000] [--config FILE]
-#       [--meshlab] [--out DIR]
+#       [--refs "A.obj B.obj"] [--meshlab] [--out DIR]
 #
 # Defaults: the two shared networks (../shared/data/sdf/nif-bunny.npz, nif-hammer.npz), budgets
 # 5000 and 50000, resolutions 32 to 512, reference 512, 1,000,000 samples per side for Chamfer (at
 # 50,000 faces 200,000 samples put a floor under the figures that hides the differences), DIR
 # target/evaluate-sdf; roar with the SDF schedule's defaults unless --config gives a file of
-# overrides. Extractions are kept (MESH.obj.json) and roar runs resumed. Needs python3 (no packages).
+# overrides. --refs gives one reference mesh per field instead of the extraction (a grid of a
+# mesh's exact distance, scripts/mesh_sdf_grid.py, against that mesh). Extractions are kept
+# (MESH.obj.json) and roar runs resumed. Needs python3 (no packages).
 # --meshlab adds, for every extraction, rows decimated by MeshLab's QEM instead of roar's
 # (scripts/peers.py qem, in the virtualenv target/eval-venv that scripts/eval_venv.sh makes).
 set -euo pipefail
@@ -29,6 +31,7 @@ resolutions="32 64 128 256 512"
 reference=512
 samples=1000000
 config=""
+refs=""
 meshlab=""
 out="target/evaluate-sdf"
 while [ $# -gt 0 ]; do
@@ -39,9 +42,10 @@ while [ $# -gt 0 ]; do
     --reference) reference="$2"; shift 2 ;;
     --samples) samples="$2"; shift 2 ;;
     --config) config="$2"; shift 2 ;;
+    --refs) refs="$2"; shift 2 ;;
     --meshlab) meshlab=1; shift ;;
     --out) out="$2"; shift 2 ;;
-    -h|--help) sed -n '2,20p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    -h|--help) sed -n '2,22p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
     *) echo "evaluate_sdf.sh: unknown argument $1" >&2; exit 2 ;;
   esac
 done
@@ -55,6 +59,9 @@ done
 python_args=()
 if [ -n "$meshlab" ]; then
   python_args=(--meshlab "$(scripts/eval_venv.sh)")
+fi
+if [ -n "$refs" ]; then
+  python_args+=(--refs $refs)
 fi
 
 echo "== building roar (release)" >&2
