@@ -5,7 +5,9 @@
 //! (same samples), to subtract from the `face_split_*` figures. `step_limiter_*`: the step
 //! limiter on two concentric ~5k-face icospheres close together (an open surface pulled onto
 //! one sheet has such pairs), once with small steps (one pass) and once with steps three times
-//! the gap (many intersecting pairs, several passes).
+//! the gap (many intersecting pairs, several passes). `untangle_crumpled_cap`: the untangle
+//! block on a ~20k-face icosphere whose top cap is crumpled by steps of about an edge length
+//! (hundreds of crossing pairs, most cleared by edge collapses).
 
 use criterion::{BatchSize, Criterion, criterion_main};
 use rand::SeedableRng;
@@ -18,7 +20,7 @@ use roar_ops::blocks::smoothing::{SmoothingOptions, tangential_smoothing};
 use roar_ops::blocks::split::{FaceSplitOptions, SplitThreshold, face_split};
 use roar_ops::geometry::Geometry;
 use roar_ops::optim::{Optimizer, OptimizerOptions};
-use roar_ops::untangle::{LimiterOptions, limit_steps};
+use roar_ops::untangle::{LimiterOptions, UntangleOptions, limit_steps, untangle};
 use std::hint::black_box;
 
 /// Latitude–longitude unit sphere: `2·lon·(lat − 1)` faces (50 × 100 → 9800).
@@ -178,6 +180,22 @@ fn blocks(c: &mut Criterion) {
     }
     group.finish();
 
+    let mut group = c.benchmark_group("untangle");
+    group.sample_size(10);
+    let crumpled = crumpled_cap(5);
+    group.bench_function("crumpled_cap_20k_faces", |b| {
+        b.iter_batched(
+            || crumpled.clone(),
+            |mut m| black_box(untangle(&mut m, &UntangleOptions::default())),
+            BatchSize::LargeInput,
+        )
+    });
+    group.finish();
+    eprintln!(
+        "untangle crumpled cap: {:?}",
+        untangle(&mut crumpled.clone(), &UntangleOptions::default())
+    );
+
     // One-off stats so the figures can be read against the work done.
     let (mut m, mut o) = (folded.clone(), optimizer(&folded));
     eprintln!(
@@ -208,6 +226,21 @@ fn two_shells(level: u32, gap: f64) -> (Vec<DVec3>, Vec<[u32; 3]>) {
     let mut triangles = t.clone();
     triangles.extend(t.iter().map(|f| f.map(|i| i + offset)));
     (positions, triangles)
+}
+
+/// An icosphere (#F = 20·4^level) whose vertices above z = 0.6 are jittered by up to an edge
+/// length per coordinate: a crumpled cap crossing itself.
+fn crumpled_cap(level: u32) -> Mesh {
+    let sphere = roar_mesh::shapes::icosphere(level);
+    let (positions, triangles) = sphere.to_triangles();
+    let edge = positions[triangles[0][0] as usize].distance(positions[triangles[0][1] as usize]);
+    let jittered = jitter(&positions, edge);
+    let crumpled = positions
+        .iter()
+        .zip(jittered)
+        .map(|(p, q)| if p.z > 0.6 { q } else { *p })
+        .collect();
+    Mesh::from_triangles(crumpled, &triangles).expect("the sphere's connectivity")
 }
 
 /// `positions` each moved by a pseudo-random step of up to `scale` per coordinate (seed 0).
