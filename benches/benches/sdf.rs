@@ -2,7 +2,9 @@
 //! for 8 × 64 and 8 × 256 sequential MLPs with random weights and for an IDR-sized implicit
 //! network (8 × 256, positional encoding with 6 frequencies, a skip into layer 4, softplus β
 //! 100), read from a `.safetensors` file the bench writes; and one SDF-loss evaluation on the
-//! 25,002 vertices of a 50,000-face mesh (a subdivided sphere) over the 8 × 64 network.
+//! 25,002 vertices of a 50,000-face mesh (a subdivided sphere) over the 8 × 64 network; and
+//! the tracer's normal maps of the drilled box example, sampled as the pipeline samples it, from
+//! 6 views at 256².
 
 use std::sync::Arc;
 
@@ -13,8 +15,11 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use roar_loss::{Loss, SdfLoss, SdfLossOptions};
 use roar_mesh::shapes::icosphere;
-use roar_mesh::spatial::{Sdf, evaluate_with_gradients};
-use roar_sdf::{Activation, Mlp};
+use roar_mesh::spatial::{Aabb, Sdf, evaluate_with_gradients};
+use roar_render::star_cameras;
+use roar_sdf::{
+    Activation, AnalyticSdf, Mlp, SampleOptions, SampledSdf, TraceOptions, trace_normal_maps,
+};
 
 /// An MLP 3 → width (× 8 hidden layers) → 1 with He-scaled random weights.
 fn network(width: usize) -> Mlp {
@@ -116,6 +121,25 @@ fn sdf_benches(c: &mut Criterion) {
     group.throughput(Throughput::Elements(vertices.len() as u64));
     group.bench_function("sdf_loss_50k_faces_mlp_8x64", |b| {
         b.iter(|| loss.value_and_grad(&vertices, &[]).unwrap())
+    });
+    group.finish();
+
+    let drilled = std::fs::read_to_string(
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples/drilled_box.sdf.toml"),
+    )
+    .expect("the drilled box example");
+    let field = AnalyticSdf::from_toml(&drilled).expect("the drilled box parses");
+    let bounds = Aabb {
+        min: DVec3::splat(-0.9),
+        max: DVec3::splat(0.9),
+    };
+    let (sampled, _) = SampledSdf::build(&field, bounds, &SampleOptions::for_resolution(256, 0.5))
+        .expect("the drilled box samples");
+    let cameras = star_cameras(3, 2, 256, 256);
+    let mut group = c.benchmark_group("trace");
+    group.sample_size(10);
+    group.bench_function("drilled_box_sampled_6_views_256", |b| {
+        b.iter(|| trace_normal_maps(&sampled, &bounds, &cameras, &TraceOptions::default()))
     });
     group.finish();
 }

@@ -3,8 +3,10 @@
 //!
 //! The tracer is grid-bracketed rather than a plain sphere tracer, to spend few SDF evaluations:
 //! 1. the SDF's values on a coarse grid of corners over the bounds (one batch, no gradients);
-//! 2. each pixel's ray, clipped to the bounds, marches the grid's trilinear interpolant in steps
-//!    of half a cell until it turns negative, which brackets the first crossing;
+//! 2. each pixel's ray, clipped to the bounds, marches the grid's trilinear interpolant until it
+//!    turns negative, which brackets the first crossing: in steps of half a cell, or of
+//!    `|value|/L` where that is longer, `L` a bound on the interpolant's slope (no crossing of
+//!    the interpolant lies closer), so empty space is crossed in a few steps;
 //! 3. the bracket is confirmed with the SDF itself (its value at both ends must change sign;
 //!    when both ends are outside, a few values inside it may find a thin part; when both are
 //!    inside, it moves back a few steps along the ray) and shrunk by
@@ -69,6 +71,9 @@ struct CornerGrid {
     /// Corners per axis.
     dims: [usize; 3],
     values: Vec<f64>,
+    /// A bound on the slope of the trilinear interpolant: `√3` times the largest difference
+    /// between neighbouring corners over the cell (finite values only); `∞` when there is none.
+    slope: f64,
 }
 
 impl CornerGrid {
@@ -91,11 +96,52 @@ impl CornerGrid {
                 *v = f64::INFINITY;
             }
         }
+        // Along each axis, the interpolant's derivative is a blend of the cell's corner
+        // differences over the cell, so its gradient is at most √3 times the largest of them.
+        let mut largest: f64 = 0.0;
+        for k in 0..dims[2] {
+            for j in 0..dims[1] {
+                for i in 0..dims[0] {
+                    let at = |i: usize, j: usize, k: usize| values[i + dims[0] * (j + dims[1] * k)];
+                    let here = at(i, j, k);
+                    for next in [
+                        (i + 1 < dims[0]).then(|| at(i + 1, j, k)),
+                        (j + 1 < dims[1]).then(|| at(i, j + 1, k)),
+                        (k + 1 < dims[2]).then(|| at(i, j, k + 1)),
+                    ]
+                    .into_iter()
+                    .flatten()
+                    {
+                        let d = (next - here).abs();
+                        if d.is_finite() {
+                            largest = largest.max(d);
+                        }
+                    }
+                }
+            }
+        }
+        let slope = if largest > 0.0 {
+            3f64.sqrt() * largest / cell
+        } else {
+            f64::INFINITY
+        };
         Self {
             origin: bounds.min,
             cell,
             dims,
             values,
+            slope,
+        }
+    }
+
+    /// How far a ray may step from a point where the interpolant is `value` without passing a
+    /// crossing: `|value|/slope`, at least `least`.
+    fn safe_step(&self, value: f64, least: f64) -> f64 {
+        let step = value.abs() / self.slope;
+        if step.is_finite() {
+            step.max(least)
+        } else {
+            least
         }
     }
 
@@ -181,7 +227,7 @@ pub fn trace_normal_maps(
                 let mut t = t_in;
                 let mut previous = grid.at(origin + t * dir);
                 while t < t_out {
-                    let next = (t + step).min(t_out);
+                    let next = (t + grid.safe_step(previous, step)).min(t_out);
                     let value = grid.at(origin + next * dir);
                     if previous >= 0.0 && value < 0.0 {
                         return Some(Bracket {
