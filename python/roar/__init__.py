@@ -198,7 +198,8 @@ def reconstruct_sdf(
     roar samples the field once, adaptively, calling ``f`` on batches of up to 16,384 points,
     one at a time; every later stage reads the samples. ``gradient``, if given, maps the same
     array to the ``(n, 3)`` gradients; without it, gradients are differences of the samples (no
-    extra calls). The field need not be distance-scaled.
+    extra calls; ``{"target": {"sdf_sample": False}}``, which has every stage evaluate the field,
+    needs ``gradient``). The field need not be distance-scaled.
 
     An exception raised by ``f``, ``gradient`` or ``progress`` propagates as itself; a result of
     the wrong shape, or one that is not finite, is a ``ValueError`` naming the batch and point.

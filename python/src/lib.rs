@@ -119,8 +119,8 @@ struct PyField {
     call: Py<PyAny>,
     /// Whether the user gave a gradient; without one, the sampler differences its samples.
     has_gradient: bool,
-    /// Central-difference step of a gradient asked of a field without one (only when the field
-    /// is not sampled: `sdf_sample = false`).
+    /// Central-difference step of a gradient asked of a field without one (a fallback: the
+    /// sampled field is all the stages read, and `sdf_sample = false` needs a gradient).
     step: f64,
     counter: SdfCounter,
     /// The first exception the callables raised. Calls are made one at a time (under this
@@ -229,6 +229,11 @@ fn reconstruct_sdf<'py>(
     progress: Option<Py<PyAny>>,
 ) -> PyResult<(Bound<'py, PyBytes>, Bound<'py, PyBytes>, String)> {
     let config = effective_config(config_json, faces, &ReconstructConfig::sdf_defaults())?;
+    if !has_gradient && !config.target.sdf_sample {
+        return Err(config_error(
+            "target.sdf_sample = false has every stage evaluate the field's gradient: give `gradient`",
+        ));
+    }
     let bounds = Aabb {
         min: DVec3::from_array(bounds.0),
         max: DVec3::from_array(bounds.1),
@@ -236,7 +241,7 @@ fn reconstruct_sdf<'py>(
     let field = Arc::new(PyField {
         call: field,
         has_gradient,
-        step: 1e-6 * bounds.diagonal(),
+        step: 1e-5 * bounds.diagonal(),
         counter: SdfCounter::default(),
         error: Mutex::new(None),
     });

@@ -385,6 +385,14 @@ def test_errors_of_the_field_are_raised_as_themselves_or_name_the_batch(f, error
         roar.reconstruct_sdf(f, TORUS_BOUNDS, 1000, config=SDF_TOY)
 
 
+def test_an_unsampled_field_needs_its_gradient():
+    calls = []
+    unsampled = dict(SDF_TOY, target=dict(SDF_TOY["target"], sdf_sample=False))
+    with pytest.raises(ValueError, match="sdf_sample = false .* give `gradient`"):
+        roar.reconstruct_sdf(lambda p: calls.append(1) or torus(p), TORUS_BOUNDS, 1000, config=unsampled)
+    assert calls == []
+
+
 def test_a_wrong_gradient_shape_names_the_batch():
     with pytest.raises(ValueError, match=r"gradient: batch 0 .* expected \(\d+, 3\)"):
         roar.reconstruct_sdf(
