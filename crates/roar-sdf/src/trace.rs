@@ -98,24 +98,15 @@ impl CornerGrid {
         }
         // Along each axis, the interpolant's derivative is a blend of the cell's corner
         // differences over the cell, so its gradient is at most √3 times the largest of them.
+        let strides = [1, dims[0], dims[0] * dims[1]];
         let mut largest: f64 = 0.0;
-        for k in 0..dims[2] {
-            for j in 0..dims[1] {
-                for i in 0..dims[0] {
-                    let at = |i: usize, j: usize, k: usize| values[i + dims[0] * (j + dims[1] * k)];
-                    let here = at(i, j, k);
-                    for next in [
-                        (i + 1 < dims[0]).then(|| at(i + 1, j, k)),
-                        (j + 1 < dims[1]).then(|| at(i, j + 1, k)),
-                        (k + 1 < dims[2]).then(|| at(i, j, k + 1)),
-                    ]
-                    .into_iter()
-                    .flatten()
-                    {
-                        let d = (next - here).abs();
-                        if d.is_finite() {
-                            largest = largest.max(d);
-                        }
+        for (idx, &here) in values.iter().enumerate() {
+            let at = [idx % dims[0], (idx / dims[0]) % dims[1], idx / strides[2]];
+            for axis in 0..3 {
+                if at[axis] + 1 < dims[axis] {
+                    let d = (values[idx + strides[axis]] - here).abs();
+                    if d.is_finite() {
+                        largest = largest.max(d);
                     }
                 }
             }
@@ -368,5 +359,56 @@ fn falsi(r: &Bracket) -> f64 {
         r.a + (r.b - r.a) * r.fa / denominator
     } else {
         0.5 * (r.a + r.b)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use roar_mesh::spatial::FnSdf;
+    use roar_render::star_cameras;
+
+    #[test]
+    fn long_steps_through_empty_space_miss_no_small_sphere() {
+        // Two spheres a few cells wide in a large box: most of every ray is empty space, where
+        // the steps are longest. Every pixel whose ray meets a sphere must see it.
+        let centres = [DVec3::new(0.5, 0.3, -0.2), DVec3::new(-0.6, -0.4, 0.3)];
+        let radius = 0.15;
+        let field = FnSdf::new(move |p: DVec3| {
+            centres
+                .iter()
+                .map(|c| p.distance(*c) - radius)
+                .fold(f64::INFINITY, f64::min)
+        });
+        let bounds = Aabb {
+            min: DVec3::splat(-1.0),
+            max: DVec3::splat(1.0),
+        };
+        let options = TraceOptions {
+            grid_resolution: 32,
+            ..TraceOptions::default()
+        };
+        let cameras = star_cameras(3, 2, 96, 96);
+        let (images, _) = trace_normal_maps(&field, &bounds, &cameras, &options);
+        let (mut expected, mut missed) = (0, 0);
+        for (camera, image) in cameras.iter().zip(&images) {
+            let inverse = camera.view_proj().inverse();
+            for (pixel, rgba) in image.iter().enumerate() {
+                let (x, y) = (pixel as u32 % camera.width, pixel as u32 / camera.width);
+                let (origin, dir) = pixel_ray(&inverse, camera, x, y);
+                // Clear of the silhouette by a tenth of the radius: grazing rays may go either way.
+                let meets = centres.iter().any(|c| {
+                    let to = *c - origin;
+                    let along = to.dot(dir);
+                    along > 0.0 && (to - along * dir).length() < 0.9 * radius
+                });
+                if meets {
+                    expected += 1;
+                    missed += usize::from(rgba[3] == 0.0);
+                }
+            }
+        }
+        assert!(expected > 500, "{expected} pixels see a sphere");
+        assert_eq!(missed, 0, "{missed} of {expected} missed");
     }
 }
