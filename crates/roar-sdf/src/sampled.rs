@@ -12,8 +12,8 @@
 //! A field that cannot give its gradient cheaply ([`Sdf::has_gradient`] false: a Python
 //! callable without one) is asked for values alone, and each sample's gradient is the central
 //! difference of its nearest lattice neighbours along each axis (one-sided where only one
-//! exists): at every level for the refinement test, and once more at the end, from the finest
-//! neighbours the octree holds.
+//! exists): at every level for the refinement test, and once more at the end for the earlier
+//! levels' samples, from the finest neighbours the octree holds.
 //!
 //! Inside a leaf with corners `xᵢ`, values `fᵢ`, gradients `gᵢ` and trilinear weights `wᵢ(p)`,
 //! the sampled field is `f(p) = Σ wᵢ (fᵢ + ½ gᵢ·(p − xᵢ))`, exact for quadratic fields, and its
@@ -233,15 +233,21 @@ impl Lattice {
             )));
         }
         if !with_gradient {
-            self.difference_gradients(start, values, gradients);
+            self.difference_gradients(start..values.len(), values, gradients);
         }
         Ok(())
     }
 
-    /// Sets the gradients of the samples from `first` on to differences of their nearest
-    /// lattice neighbours: per axis, the smallest spacing `2^k` with a neighbour at `±2^k`;
-    /// central when both exist, one-sided when one does.
-    fn difference_gradients(&self, first: usize, values: &[f64], gradients: &mut [DVec3]) {
+    /// Sets the gradients of the samples in `range` to differences of their nearest lattice
+    /// neighbours: per axis, the smallest spacing `2^k` with a neighbour at `±2^k`; central
+    /// when both exist, one-sided when one does.
+    fn difference_gradients(
+        &self,
+        range: std::ops::Range<usize>,
+        values: &[f64],
+        gradients: &mut [DVec3],
+    ) {
+        let first = range.start;
         let neighbour = |p: [u32; 3], axis: usize, offset: i64| {
             let c = i64::from(p[axis]) + offset;
             if c < 0 || c > i64::from(self.resolution) {
@@ -251,9 +257,9 @@ impl Lattice {
             q[axis] = c as u32;
             self.index.get(&key(q)).map(|&i| values[i as usize])
         };
-        gradients[first..]
+        gradients[range.clone()]
             .par_iter_mut()
-            .zip(&self.coords[first..])
+            .zip(&self.coords[range])
             .enumerate()
             .for_each(|(n, (g, &p))| {
                 let f = values[first + n];
@@ -329,6 +335,8 @@ impl SampledSdf {
             }
         }
         lattice.flush(field, &mut values, &mut gradients)?;
+        // Where the last flush's samples start: they were differenced with every sample there.
+        let mut newest = 0;
         for _ in 0..levels {
             let split: Vec<(u32, [u32; 3], u32)> = level
                 .iter()
@@ -366,13 +374,14 @@ impl SampledSdf {
                     });
                 }
             }
+            newest = values.len();
             lattice.flush(field, &mut values, &mut gradients)?;
             level = next;
         }
         let field_gradients = field.has_gradient();
         if !field_gradients {
-            // Every sample's differences again, now from the finest neighbours.
-            lattice.difference_gradients(0, &values, &mut gradients);
+            // The earlier levels' differences again, now from the finest neighbours.
+            lattice.difference_gradients(0..newest, &values, &mut gradients);
         }
         // The last level's cells are the finest ones.
         let finest_leaves = level.len();
