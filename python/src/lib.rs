@@ -29,6 +29,22 @@ create_exception!(
     "roar could not do the work asked (the message is the CLI's)."
 );
 
+/// Points as `<f8` bytes, x, y, z in turn, as the Python half reads `(n, 3)` arrays.
+fn points_to_bytes(points: &[DVec3]) -> Vec<u8> {
+    points
+        .iter()
+        .flat_map(|v| v.to_array())
+        .flat_map(f64::to_le_bytes)
+        .collect()
+}
+
+/// The `f64`s of `<f8` bytes (a trailing partial number is dropped).
+fn f64s_from_bytes(bytes: &[u8]) -> impl Iterator<Item = f64> + '_ {
+    bytes
+        .chunks_exact(8)
+        .map(|c| f64::from_le_bytes(c.try_into().expect("8-byte chunk")))
+}
+
 /// Positions and triangles decoded from the bytes the Python half sends.
 fn soup_from_bytes(positions: &[u8], triangles: &[u8]) -> PyResult<TriangleSoup> {
     if !positions.len().is_multiple_of(24) || !triangles.len().is_multiple_of(12) {
@@ -36,11 +52,11 @@ fn soup_from_bytes(positions: &[u8], triangles: &[u8]) -> PyResult<TriangleSoup>
             "internal: position or triangle bytes are not whole rows",
         ));
     }
-    let f = |c: &[u8]| f64::from_le_bytes(c.try_into().expect("8-byte chunk"));
     let u = |c: &[u8]| u32::from_le_bytes(c.try_into().expect("4-byte chunk"));
-    let positions = positions
-        .chunks_exact(24)
-        .map(|r| DVec3::new(f(&r[..8]), f(&r[8..16]), f(&r[16..])))
+    let coordinates: Vec<f64> = f64s_from_bytes(positions).collect();
+    let positions = coordinates
+        .chunks_exact(3)
+        .map(|c| DVec3::new(c[0], c[1], c[2]))
         .collect();
     let triangles = triangles
         .chunks_exact(12)
@@ -58,11 +74,7 @@ fn soup_to_bytes<'py>(
     positions: &[DVec3],
     triangles: &[[u32; 3]],
 ) -> (Bound<'py, PyBytes>, Bound<'py, PyBytes>) {
-    let p: Vec<u8> = positions
-        .iter()
-        .flat_map(|v| v.to_array())
-        .flat_map(f64::to_le_bytes)
-        .collect();
+    let p = points_to_bytes(positions);
     let t: Vec<u8> = triangles
         .iter()
         .flatten()
@@ -117,11 +129,9 @@ fn reconstruct<'py>(
 /// bytes of `n` values (then `3n` gradient components when asked).
 struct PyField {
     call: Py<PyAny>,
-    /// Whether the user gave a gradient; without one, the sampler differences its samples.
+    /// Whether the user gave a gradient; without one, the sampler differences its samples (the
+    /// only caller of the field: `sdf_sample = false` is refused without a gradient).
     has_gradient: bool,
-    /// Central-difference step of a gradient asked of a field without one (a fallback: the
-    /// sampled field is all the stages read, and `sdf_sample = false` needs a gradient).
-    step: f64,
     counter: SdfCounter,
     /// The first exception the callables raised. Calls are made one at a time (under this
     /// lock); after an exception no batch is sent and every value reads NaN, which stops the run.
@@ -134,20 +144,12 @@ impl PyField {
         let mut error = self.error.lock().unwrap_or_else(|e| e.into_inner());
         if error.is_none() {
             let with_gradient = gradients.is_some();
-            let bytes: Vec<u8> = points
-                .iter()
-                .flat_map(|p| p.to_array())
-                .flat_map(f64::to_le_bytes)
-                .collect();
+            let bytes = points_to_bytes(points);
             let returned = Python::attach(|py| -> PyResult<Vec<f64>> {
                 let out = self
                     .call
                     .call1(py, (PyBytes::new(py, &bytes), with_gradient))?;
-                let out = out.bind(py).cast::<PyBytes>()?.as_bytes().to_vec();
-                Ok(out
-                    .chunks_exact(8)
-                    .map(|c| f64::from_le_bytes(c.try_into().expect("8-byte chunk")))
-                    .collect())
+                Ok(f64s_from_bytes(out.bind(py).cast::<PyBytes>()?.as_bytes()).collect())
             });
             let n = points.len();
             match returned {
@@ -179,29 +181,19 @@ impl Sdf for PyField {
         self.call(points, values, None);
     }
 
+    /// Without the user's gradient this is a bug of roar's: it records an internal error (the
+    /// run stops on the NaN values) rather than guess.
     fn values_and_gradients(&self, points: &[DVec3], values: &mut [f64], gradients: &mut [DVec3]) {
-        if self.has_gradient {
-            self.counter.add_gradients(points.len());
-            self.call(points, values, Some(gradients));
+        if !self.has_gradient {
+            let mut error = self.error.lock().unwrap_or_else(|e| e.into_inner());
+            error.get_or_insert_with(|| {
+                PyRuntimeError::new_err("internal: a field without `gradient` was asked for one")
+            });
+            values.fill(f64::NAN);
             return;
         }
-        // The points, then their six neighbours at ±step along each axis, in one call.
-        let h = self.step;
-        let mut all = points.to_vec();
-        for e in [DVec3::X, DVec3::Y, DVec3::Z] {
-            all.extend(points.iter().map(|p| *p + h * e));
-            all.extend(points.iter().map(|p| *p - h * e));
-        }
-        let mut out = vec![0.0; all.len()];
-        self.values(&all, &mut out);
-        let n = points.len();
-        values.copy_from_slice(&out[..n]);
-        for (i, g) in gradients.iter_mut().enumerate() {
-            let d = |axis: usize| {
-                (out[n * (1 + 2 * axis) + i] - out[n * (2 + 2 * axis) + i]) / (2.0 * h)
-            };
-            *g = DVec3::new(d(0), d(1), d(2));
-        }
+        self.counter.add_gradients(points.len());
+        self.call(points, values, Some(gradients));
     }
 
     fn evaluations(&self) -> SdfEvaluations {
@@ -241,7 +233,6 @@ fn reconstruct_sdf<'py>(
     let field = Arc::new(PyField {
         call: field,
         has_gradient,
-        step: 1e-5 * bounds.diagonal(),
         counter: SdfCounter::default(),
         error: Mutex::new(None),
     });
