@@ -297,10 +297,10 @@ def measure(args, item, method, budget, entry, group="eval"):
     cache = os.path.join(args.out, group, method, item["id"], "%d.json" % budget)
     cached = load_json(cache)
     if (cached and cached.get("output_sha256") == output_sha
-            and cached.get("roar_sha256") == args.roar_sha and cached.get("samples") == args.samples):
+            and cached.get("roar_sha256") == args.measure_sha and cached.get("samples") == args.samples):
         report = cached["report"]
     else:
-        cmd = [args.roar, "eval", entry["output"], "--ref", item["path"], "--json", "--samples",
+        cmd = [args.measure_with, "eval", entry["output"], "--ref", item["path"], "--json", "--samples",
                str(args.samples)]
         outcome = run(cmd, args.timeout, cache[:-len(".json")] + ".log")
         try:
@@ -311,7 +311,7 @@ def measure(args, item, method, budget, entry, group="eval"):
         if report is None:
             entry["error"] = "eval failed: %s" % outcome["error"]
             return
-        write_json(cache, {"output_sha256": output_sha, "roar_sha256": args.roar_sha,
+        write_json(cache, {"output_sha256": output_sha, "roar_sha256": args.measure_sha,
                            "samples": args.samples, "report": report})
     entry["metrics"] = headline(report, budget)
 
@@ -568,6 +568,7 @@ def evaluate(args, items, methods):
         "timeout": args.timeout,
         "roar": args.roar,
         "roar_sha256": args.roar_sha,
+        "measured_with": args.measure_with,
         "models": {},
     }
     if "roar" in methods:
@@ -724,7 +725,7 @@ def paired(args, items):
         "started": datetime.datetime.now().isoformat(timespec="seconds"),
         "manifest": args.manifest, "subset": args.subset, "budgets": args.budgets,
         "samples": args.samples, "old": old, "new": new, "old_sha256": shas["old"],
-        "new_sha256": shas["new"], "evaluator": args.roar, "models": {},
+        "new_sha256": shas["new"], "evaluator": args.measure_with, "models": {},
     }
     for index, item in enumerate(items, 1):
         model = {"family": item.get("family", ""), "input_faces": item.get("input_faces", ""),
@@ -749,6 +750,9 @@ def main():
     parser = argparse.ArgumentParser(description="roar and its peers over the corpus; "
                                      "see docs/evaluation.md, \"Dataset table\"")
     parser.add_argument("--roar", required=True, help="the roar binary (runs roar, measures all)")
+    parser.add_argument("--measure-with", metavar="ROAR",
+                        help="the roar binary whose `eval` measures every output (default: --roar); "
+                        "a fixed one keeps the measurements cached across roar builds")
     parser.add_argument("--python", help="python of the peers' virtualenv")
     parser.add_argument("--manifest", required=True, help="the corpus manifest (TSV)")
     parser.add_argument("--subset", help="file of ids to take from the manifest")
@@ -778,6 +782,8 @@ def main():
     items = select(args)
     os.makedirs(args.out, exist_ok=True)
     args.roar_sha = sha256(args.roar)
+    args.measure_with = os.path.abspath(args.measure_with or args.roar)
+    args.measure_sha = sha256(args.measure_with)
     signal.signal(signal.SIGTERM, on_signal)
     signal.signal(signal.SIGINT, on_signal)
     try:

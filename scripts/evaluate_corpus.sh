@@ -7,7 +7,8 @@
 #   scripts/evaluate_corpus.sh [--manifest PATH] [--subset scripts/corpus-subset-50.tsv]
 #       [--ids "ID ..."] [--limit K] [--budgets "500 1000 5000 10000"]
 #       [--methods "roar alphawrap+qem manifold+qem"] [--out DIR] [--timeout SECONDS]
-#       [--jobs J] [--samples S] [--retry-failed] [--paired OLD_ROAR NEW_ROAR]
+#       [--jobs J] [--samples S] [--measure-with ROAR] [--retry-failed]
+#       [--paired OLD_ROAR NEW_ROAR]
 #
 # Default manifest: $ROAR_TEST_DATA/../corpus/manifest.tsv (ROAR_TEST_DATA: ../shared/data/meshes
 # beside the repo). Default DIR: target/corpus-eval. The peers run in the virtualenv
@@ -18,7 +19,7 @@ repo="$(pwd)"
 
 for arg in "$@"; do
   case "$arg" in
-    -h|--help) sed -n '2,14p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+    -h|--help) sed -n '2,15p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
   esac
 done
 
