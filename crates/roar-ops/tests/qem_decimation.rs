@@ -491,3 +491,56 @@ fn a_degenerate_limit_below_the_last_bound_or_not_finite_is_refused_by_name() {
         assert_eq!(m.n_faces(), 320, "the mesh is untouched");
     }
 }
+
+/// The bumpy sphere's signed distance (approximately: a sphere of radius 0.9 with bumps of 0.08).
+fn bumpy_sphere(p: glam::DVec3) -> f64 {
+    p.length() - 0.9 - 0.08 * (5.0 * p.x).sin() * (4.0 * p.y).sin() * (3.0 * p.z).cos()
+}
+
+/// A marching tetrahedra extraction of [`bumpy_sphere`]: closed, every face a cut of a grid
+/// tetrahedron, many of them slivers.
+fn marching_bumpy_sphere(samples: usize) -> Mesh {
+    let (min, max) = (glam::DVec3::splat(-1.2), glam::DVec3::splat(1.2));
+    let step = (max - min) / (samples - 1) as f64;
+    let mut values = Vec::with_capacity(samples * samples * samples);
+    for i in 0..samples {
+        for j in 0..samples {
+            for k in 0..samples {
+                let p = min + glam::DVec3::new(i as f64, j as f64, k as f64) * step;
+                values.push(bumpy_sphere(p) as f32);
+            }
+        }
+    }
+    let (positions, triangles) =
+        roar_mesh::spatial::marching_tetrahedra(&values, [samples; 3], min, max);
+    Mesh::from_triangles(positions, &triangles).expect("a closed extraction")
+}
+
+#[test]
+fn a_marching_extraction_full_of_slivers_reaches_small_budgets() {
+    let mesh = marching_bumpy_sphere(96);
+    // No vertex leaves the surface by more than the bumps' height (0.08). (At 2000 faces the
+    // farthest is 0.044: the collapses that remove slivers cost less, see
+    // `DecimateOptions::degenerate_quality`.)
+    for (target, tolerance) in [(2000, 0.08), (200, 0.08), (4, f64::INFINITY)] {
+        let m = decimate_and_check(&mesh, target);
+        let farthest = m
+            .vertices()
+            .map(|v| bumpy_sphere(m.position(v)).abs())
+            .fold(0.0, f64::max);
+        assert!(
+            farthest <= tolerance,
+            "{target} faces: a vertex {farthest} off the surface"
+        );
+    }
+    // Bounded at 20, without the last step, the slivers block the budget.
+    let twenty = DecimateOptions {
+        quality_bounds: vec![10.0, 20.0],
+        ..DecimateOptions::default()
+    };
+    let stalled = decimate(&mut mesh.clone(), 200, &twenty);
+    assert!(
+        matches!(stalled, Err(DecimateError::BudgetNotReached { .. })),
+        "{stalled:?}"
+    );
+}

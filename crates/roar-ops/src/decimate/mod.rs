@@ -27,7 +27,7 @@
 //!
 //! When the heap runs dry above the target, the edges are re-queued (vetoes are local, so
 //! collapses elsewhere may have unblocked them) and, when a whole pass makes no progress, the
-//! quality bound is relaxed stepwise (`quality_bounds`, 10 → 20). The manifold,
+//! quality bound is relaxed stepwise (`quality_bounds`, 10 → 20 → 100). The manifold,
 //! orientation and intersection vetoes are never relaxed.
 //!
 //! [`decimate_in_parallel`] gives the same promises on two threads for large meshes (the initial
