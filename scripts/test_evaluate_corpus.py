@@ -2,6 +2,7 @@
 """Tests of scripts/evaluate_corpus.py and scripts/corpus_subset.py:
 `python3 scripts/test_evaluate_corpus.py` (standard library only, a few seconds, no roar)."""
 import importlib.util
+import json
 import os
 import subprocess
 import sys
@@ -152,6 +153,31 @@ class Commands(unittest.TestCase):
             done = ev.roar_entry(args, item, 1000)
             self.assertEqual((done["seconds"], done["wall_seconds"]), (7.0, 9.0))
             self.assertEqual(ev.outcome_of(ev.roar_entry(args, item, 5000))[0], "missing")
+
+    def test_measurements_are_kept_while_the_measuring_binary_is_the_same(self):
+        with tempfile.TemporaryDirectory() as tmp:
+            calls = os.path.join(tmp, "calls")
+            fake = os.path.join(tmp, "roar")  # `roar eval ... --json`: one valid report
+            with open(fake, "w") as f:
+                f.write("#!/bin/sh\necho eval >> %s\necho '%s'\n" % (
+                    calls, json.dumps(report())))
+            os.chmod(fake, 0o755)
+            output = os.path.join(tmp, "out.obj")
+            with open(output, "w") as f:
+                f.write("v 0 0 0\n")
+            args = type("Args", (), dict(out=tmp, measure_with=fake, measure_sha=ev.sha256(fake),
+                                         samples=100, timeout=10))()
+            item = {"id": "m", "path": "/input.obj"}
+            for _ in range(2):  # a new roar build changes neither the output nor the measurer
+                entry = {"output": output}
+                ev.measure(args, item, "manifold+qem", 500, entry)
+                self.assertTrue(entry["metrics"]["valid"])
+            with open(calls) as f:
+                self.assertEqual(f.read().split(), ["eval"])
+            args.measure_sha = "another measuring binary"
+            ev.measure(args, item, "manifold+qem", 500, {"output": output})
+            with open(calls) as f:
+                self.assertEqual(f.read().split(), ["eval", "eval"])
 
     def test_a_failing_command_reports_its_last_line(self):
         outcome = ev.run(["sh", "-c", "echo noise >&2; echo 'roar: error: no budget' >&2; exit 3"],
