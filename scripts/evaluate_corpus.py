@@ -10,8 +10,8 @@ Per model and face budget:
                    OUT/peers/<method>/<id>/<budget>.json, so a rerun skips it,
 
 and every output measured the same way, by `roar eval OUT --ref RAW_INPUT --json --samples S`
-(cached in OUT/eval/<method>/<id>/<budget>.json, keyed by the output's and the roar binary's
-SHA-256). Writes OUT/table.md, OUT/results.json and OUT/models.tsv after every model.
+(cached in OUT/eval/<method>/<id>/<budget>.json, keyed by the SHA-256 of the output and of the
+measuring binary, `--measure-with`, by default the roar binary). Writes OUT/table.md, OUT/results.json and OUT/models.tsv after every model.
 
 `--paired OLD NEW` instead runs two roar binaries on each model, OLD then NEW, one process at a
 time, and writes OUT/paired.md and OUT/paired.json (per-model seconds ratio and Chamfer change).
@@ -749,7 +749,7 @@ def paired(args, items):
 def main():
     parser = argparse.ArgumentParser(description="roar and its peers over the corpus; "
                                      "see docs/evaluation.md, \"Dataset table\"")
-    parser.add_argument("--roar", required=True, help="the roar binary (runs roar, measures all)")
+    parser.add_argument("--roar", required=True, help="the roar binary (runs roar, and measures every output unless --measure-with)")
     parser.add_argument("--measure-with", metavar="ROAR",
                         help="the roar binary whose `eval` measures every output (default: --roar); "
                         "a fixed one keeps the measurements cached across roar builds")
