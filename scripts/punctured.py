@@ -66,6 +66,7 @@ import collections
 import math
 import os
 import random
+import struct
 import sys
 
 HERE = os.path.dirname(os.path.abspath(__file__))
@@ -169,9 +170,30 @@ def read_off(path):
     return verts, faces
 
 
+def read_stl(path):
+    """Vertices (one per corner, unwelded) and triangles of a binary or ASCII STL file."""
+    with open(path, 'rb') as f:
+        data = f.read()
+    corners = []
+    count = struct.unpack_from('<I', data, 80)[0] if len(data) >= 84 else -1
+    if len(data) == 84 + 50 * count:
+        for i in range(count):
+            corners.extend(struct.unpack_from('<3f', data, 84 + 50 * i + 12 + 12 * k)
+                           for k in range(3))
+    else:
+        corners = [tuple(float(x) for x in line.split()[1:4])
+                   for line in data.decode('latin-1').splitlines()
+                   if line.strip().startswith('vertex')]
+    corners = corners[:len(corners) - len(corners) % 3]
+    return corners, [(i, i + 1, i + 2) for i in range(0, len(corners), 3)]
+
+
 def read_mesh(path):
-    """Vertices and triangles of an OBJ or OFF file."""
-    return read_off(path) if path.lower().endswith('.off') else read_obj(path)
+    """Vertices and triangles of an OBJ, OFF or STL file."""
+    lower = path.lower()
+    if lower.endswith('.off'):
+        return read_off(path)
+    return read_stl(path) if lower.endswith('.stl') else read_obj(path)
 
 
 def compact(verts, faces):

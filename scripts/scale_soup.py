@@ -21,6 +21,8 @@ import sys
 
 import numpy as np
 
+from punctured import read_mesh  # this folder's OBJ, OFF and STL reader
+
 
 def default_manifest():
     data = os.environ.get("ROAR_TEST_DATA") or os.path.join(
@@ -49,48 +51,12 @@ def pick_models(manifest, count, most_faces, rng):
     return [(row["id"], os.path.join(base, row["path"])) for row in picked]
 
 
-def read_obj(path):
-    """The triangles of an OBJ file (polygons as fans, negative indices resolved)."""
-    positions, triangles = [], []
-    with open(path, "rb") as f:
-        for raw in f:
-            parts = raw.split()
-            if not parts:
-                continue
-            if parts[0] == b"v" and len(parts) >= 4:
-                positions.append([float(x) for x in parts[1:4]])
-            elif parts[0] == b"f" and len(parts) >= 4:
-                corners = []
-                for token in parts[1:]:
-                    i = int(token.split(b"/")[0])
-                    corners.append(i - 1 if i > 0 else len(positions) + i)
-                for k in range(1, len(corners) - 1):
-                    triangles.append([positions[corners[0]], positions[corners[k]],
-                                      positions[corners[k + 1]]])
-    return triangles
-
-
-def read_stl(path):
-    """The triangles of a binary or ASCII STL file."""
-    with open(path, "rb") as f:
-        data = f.read()
-    if len(data) >= 84:
-        count = struct.unpack_from("<I", data, 80)[0]
-        if len(data) == 84 + 50 * count:
-            return [[list(struct.unpack_from("<3f", data, 84 + 50 * i + 12 + 12 * k))
-                     for k in range(3)] for i in range(count)]
-    corners = [[float(x) for x in line.split()[1:4]]
-               for line in data.decode("latin-1").splitlines()
-               if line.strip().startswith("vertex")]
-    return [corners[i:i + 3] for i in range(0, len(corners) - 2, 3)]
-
-
 def load_triangles(path):
     """The model's triangles as a (F, 3, 3) float array, centred and scaled to unit size."""
-    triangles = read_stl(path) if path.lower().endswith(".stl") else read_obj(path)
-    corners = np.asarray(triangles, dtype=np.float64).reshape(-1, 3, 3)
-    if len(corners) == 0:
+    verts, faces = read_mesh(path)
+    if not faces:
         return None
+    corners = np.asarray(verts, dtype=np.float64)[np.asarray(faces)]
     low, high = corners.reshape(-1, 3).min(0), corners.reshape(-1, 3).max(0)
     size = float((high - low).max())
     if not math.isfinite(size) or size <= 0:

@@ -8,6 +8,7 @@ import collections
 import importlib.util
 import math
 import os
+import struct
 import subprocess
 import sys
 import tempfile
@@ -163,6 +164,25 @@ class Readers(unittest.TestCase):
             verts, faces = pu.read_off(self.write('a.off', text))
             self.assertEqual(len(verts), 4)
             self.assertEqual(faces, [(0, 1, 2), (0, 2, 3)])
+
+    def test_binary_and_ascii_stl_give_the_same_corners(self):
+        triangle = [(0.0, 0.0, 0.0), (1.0, 0.0, 0.0), (0.0, 1.0, 0.5)]
+        binary = b'solid but binary'.ljust(80) + struct.pack('<I', 2)
+        ascii_text = 'solid t\n'
+        for _ in range(2):
+            binary += struct.pack('<12fH', 0, 0, 1, *[x for c in triangle for x in c], 0)
+            ascii_text += ('facet normal 0 0 1\nouter loop\n'
+                           + ''.join('vertex %g %g %g\n' % c for c in triangle)
+                           + 'endloop\nendfacet\n')
+        ascii_text += 'endsolid t\n'
+        tmp = tempfile.TemporaryDirectory()
+        self.addCleanup(tmp.cleanup)
+        path = os.path.join(tmp.name, 'b.stl')
+        with open(path, 'wb') as f:
+            f.write(binary)
+        for verts, faces in (pu.read_mesh(path), pu.read_mesh(self.write('a.stl', ascii_text))):
+            self.assertEqual(verts, triangle + triangle)
+            self.assertEqual(faces, [(0, 1, 2), (3, 4, 5)])
 
 
 class Puncturing(unittest.TestCase):
