@@ -13,6 +13,9 @@ and every output measured the same way, by `roar eval OUT --ref RAW_INPUT --json
 (cached in OUT/eval/<method>/<id>/<budget>.json, keyed by the SHA-256 of the output and of the
 measuring binary, `--measure-with`, by default the roar binary). Writes OUT/table.md, OUT/results.json and OUT/models.tsv after every model.
 
+`--no-run` runs neither roar nor a peer: it measures and tabulates what OUT already holds, so
+runs made separately (one budget at a time, in folders linked into one OUT) give one table.
+
 `--paired OLD NEW` instead runs two roar binaries on each model, OLD then NEW, one process at a
 time, and writes OUT/paired.md and OUT/paired.json (per-model seconds ratio and Chamfer change).
 
@@ -263,6 +266,8 @@ def peer_entries(args, item, method):
     records = {b: load_json(path(b)) for b in args.budgets}
     todo = [b for b in args.budgets
             if records[b] is None or ("error" in records[b] and args.retry_failed)]
+    if args.no_run:
+        return {b: records[b] or {"missing": True} for b in args.budgets}
     if todo:
         os.makedirs(folder, exist_ok=True)
         cmd = [args.python, os.path.join(args.scripts, "peers.py"), PEERS[method], item["path"],
@@ -571,7 +576,7 @@ def evaluate(args, items, methods):
         "measured_with": args.measure_with,
         "models": {},
     }
-    if "roar" in methods:
+    if "roar" in methods and not args.no_run:
         run_roar_batch(args, items)
     for index, item in enumerate(items, 1):
         runs = {}
@@ -767,6 +772,9 @@ def main():
     parser.add_argument("--retry-failed", action="store_true",
                         help="rerun the peers' (and --paired runs') recorded failures")
     parser.add_argument("--paired", nargs=2, metavar=("OLD_ROAR", "NEW_ROAR"))
+    parser.add_argument("--no-run", action="store_true",
+                        help="run neither roar nor a peer: measure and tabulate the outputs "
+                        "already in OUT (e.g. budgets run separately, by builds with the same output)")
     args = parser.parse_args()
     args.budgets = [int(b) for b in args.budgets.replace(",", " ").split()]
     args.scripts = os.path.dirname(os.path.abspath(__file__))
@@ -777,7 +785,7 @@ def main():
     unknown = [m for m in methods if m not in METHODS]
     if unknown:
         parser.error("unknown methods %s (known: %s)" % (" ".join(unknown), " ".join(METHODS)))
-    if not args.paired and any(m in PEERS for m in methods) and not args.python:
+    if not (args.paired or args.no_run) and any(m in PEERS for m in methods) and not args.python:
         parser.error("--python is needed for the peers")
     items = select(args)
     os.makedirs(args.out, exist_ok=True)

@@ -7,7 +7,7 @@
 #   scripts/evaluate_corpus.sh [--manifest PATH] [--subset scripts/corpus-subset-50.tsv]
 #       [--ids "ID ..."] [--limit K] [--budgets "500 1000 5000 10000"]
 #       [--methods "roar alphawrap+qem manifold+qem"] [--out DIR] [--timeout SECONDS]
-#       [--jobs J] [--samples S] [--measure-with ROAR] [--retry-failed]
+#       [--jobs J] [--samples S] [--measure-with ROAR] [--retry-failed] [--no-run]
 #       [--paired OLD_ROAR NEW_ROAR]
 #
 # Default manifest: $ROAR_TEST_DATA/../corpus/manifest.tsv (ROAR_TEST_DATA: ../shared/data/meshes

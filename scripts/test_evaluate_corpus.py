@@ -120,7 +120,8 @@ class Commands(unittest.TestCase):
                 f.write("#!/bin/sh\necho run >> %s\nsleep 60\n" % runs)
             os.chmod(fake, 0o755)
             args = type("Args", (), dict(out=tmp, budgets=[500, 1000], python=fake,
-                                         scripts=HERE, timeout=1, retry_failed=False))()
+                                         scripts=HERE, timeout=1, retry_failed=False,
+                                         no_run=False))()
             item = {"id": "m", "path": "/nonexistent.obj"}
             first = ev.peer_entries(args, item, "manifold+qem")
             self.assertEqual({b: e["error"] for b, e in first.items()},
@@ -178,6 +179,37 @@ class Commands(unittest.TestCase):
             ev.measure(args, item, "manifold+qem", 500, {"output": output})
             with open(calls) as f:
                 self.assertEqual(f.read().split(), ["eval", "eval"])
+
+    def test_no_run_tabulates_the_outputs_already_there_and_runs_nothing(self):
+        with tempfile.TemporaryDirectory() as tmp:
+            fake = os.path.join(tmp, "fake-roar")  # only `roar eval` may be called: one valid report
+            with open(fake, "w") as f:
+                f.write("#!/bin/sh\n[ \"$1\" = eval ] || exit 3\necho '%s'\n" % json.dumps(report()))
+            os.chmod(fake, 0o755)
+            folder = os.path.join(tmp, "roar", "m")
+            os.makedirs(folder)
+            with open(os.path.join(folder, "500.obj"), "w") as f:
+                f.write("v 0 0 0\n")
+            ev.write_json(os.path.join(folder, "500.json"), {
+                "seconds": 4.0, "reconstruct": {"run": {"seconds": {"init": 1.0, "loop": 2.0}}}})
+            peer = os.path.join(tmp, "peers", "manifold+qem", "m")
+            os.makedirs(peer)
+            with open(os.path.join(peer, "500.obj"), "w") as f:
+                f.write("v 1 0 0\n")
+            ev.write_json(os.path.join(peer, "500.json"), {"output": os.path.join(peer, "500.obj"),
+                                                         "seconds": 1.0})
+            args = type("Args", (), dict(
+                out=tmp, no_run=True, python="/no/python", scripts=HERE, roar=fake, roar_sha="x",
+                measure_with=fake, measure_sha=ev.sha256(fake), samples=100, timeout=10,
+                budgets=[500, 1000], retry_failed=False, manifest="m.tsv", subset=None))()
+            ev.evaluate(args, [{"id": "m", "path": "/input.obj"}], ["roar", "manifold+qem"])
+            with open(os.path.join(tmp, "results.json")) as f:
+                summary = json.load(f)["summary"]
+            for method in ("roar", "manifold+qem"):
+                self.assertEqual(summary["500"]["methods"][method]["valid"], 1)
+                self.assertEqual(summary["1000"]["methods"][method]["missing"], 1)
+            self.assertEqual(summary["500"]["methods"]["roar"]["median_seconds"], 3.0)
+            self.assertFalse(os.path.exists(os.path.join(tmp, "manifest.tsv")))  # no batch ran
 
     def test_a_failing_command_reports_its_last_line(self):
         outcome = ev.run(["sh", "-c", "echo noise >&2; echo 'roar: error: no budget' >&2; exit 3"],
