@@ -11,7 +11,8 @@ Per model and face budget:
 
 and every output measured the same way, by `roar eval OUT --ref RAW_INPUT --json --samples S`
 (cached in OUT/eval/<method>/<id>/<budget>.json, keyed by the SHA-256 of the output and of the
-measuring binary, `--measure-with`, by default the roar binary). Writes OUT/table.md, OUT/results.json and OUT/models.tsv after every model.
+measuring binary, `--measure-with`, by default the roar binary). Writes OUT/table.md,
+OUT/results.json and OUT/models.tsv after every model.
 
 `--no-run` runs neither roar nor a peer: it measures and tabulates what OUT already holds, so
 runs made separately (one budget at a time, in folders linked into one OUT) give one table.
@@ -264,10 +265,10 @@ def peer_entries(args, item, method):
     folder = os.path.join(args.out, "peers", method, item["id"])
     path = lambda b: os.path.join(folder, "%d.json" % b)
     records = {b: load_json(path(b)) for b in args.budgets}
-    todo = [b for b in args.budgets
-            if records[b] is None or ("error" in records[b] and args.retry_failed)]
     if args.no_run:
         return {b: records[b] or {"missing": True} for b in args.budgets}
+    todo = [b for b in args.budgets
+            if records[b] is None or ("error" in records[b] and args.retry_failed)]
     if todo:
         os.makedirs(folder, exist_ok=True)
         cmd = [args.python, os.path.join(args.scripts, "peers.py"), PEERS[method], item["path"],
