@@ -34,12 +34,15 @@ whose file is missing (or is not the closed mesh of its genus) is skipped with a
 For seed s every draw comes from random.Random("OBJECT:s") (string seeds are hashed with SHA-512,
 so they do not depend on PYTHONHASHSEED), in this order:
   1. a target removed fraction of the area, uniform in [0.10, 0.40];
-  2. holes until the target is reached: a seed face (area-weighted among the faces left) and
-     rho = u * (local feature size), u uniform in [0.25, 0.5] (so a hole is at most as wide as the
-     local feature size: a tube's holes are up to its radius wide), capped at 0.1 x the bounding-box
-     diagonal; the hole is the breadth-first patch of edge-adjacent faces whose centroid is within
-     rho of the seed face's centroid. The last hole stops at the face that reaches the target,
-     so the removed fraction exceeds the target by less than one face's area;
+  2. holes until the target is reached: a seed face (area-weighted among the free faces: those
+     with no vertex on an earlier hole) and rho = u * (local feature size), u uniform in
+     [0.25, 0.5] (so a hole is at most as wide as the local feature size: a tube's holes are up to
+     its radius wide), capped at 0.1 x the bounding-box diagonal; the hole is the breadth-first
+     patch of edge-adjacent free faces whose centroid is within rho of the seed face's centroid.
+     Holes never touch, so each is one gap no wider than its feature, never a merger of several.
+     The last hole stops at the face that reaches the target, so the removed fraction exceeds the
+     target by less than one face's area; it falls short only when no free face is left (coarse
+     tessellations);
   3. k pieces, k uniform in [8, 30]: k seed faces among those left grow round-robin by
      breadth-first search over edge adjacency; faces no seed reaches form one piece per
      connected part. Each piece has its own copies of its vertices;
@@ -63,6 +66,7 @@ piece). One line per written file goes to stderr.
 import argparse
 import bisect
 import collections
+import itertools
 import math
 import os
 import random
@@ -702,8 +706,24 @@ class Surface:
         i = bisect.bisect_right(self.cumulative, rng.random() * self.total_area)
         return min(i, len(self.faces) - 1)
 
-    def patch(self, seed, radius):
-        """Faces with centroid within `radius` of seed's, reached breadth-first, in order."""
+    def sample_face_where(self, rng, keep):
+        """A face drawn with probability proportional to its area among those `keep` accepts, or
+        None when it accepts none. Draws from all faces first and lists the kept ones only when
+        64 draws miss, so the common case costs no pass over the faces."""
+        for _ in range(64):
+            f = self.sample_face(rng)
+            if keep(f):
+                return f
+        kept = [f for f in range(len(self.faces)) if keep(f)]
+        if not kept:
+            return None
+        cumulative = list(itertools.accumulate(self.areas[f] for f in kept))
+        i = bisect.bisect_right(cumulative, rng.random() * cumulative[-1])
+        return kept[min(i, len(kept) - 1)]
+
+    def patch(self, seed, radius, keep=lambda f: True):
+        """Faces `keep` accepts with centroid within `radius` of seed's, reached breadth-first
+        from seed over edge-adjacent accepted faces, in order."""
         centre = self.centroids[seed]
         r2 = radius * radius
         order, seen = [seed], {seed}
@@ -711,7 +731,7 @@ class Surface:
         while queue:
             f = queue.popleft()
             for g in self.neighbours[f]:
-                if g in seen:
+                if g in seen or not keep(g):
                     continue
                 seen.add(g)
                 d = sub(self.centroids[g], centre)
@@ -728,21 +748,29 @@ def punch_holes(surface, rng):
     """Removed flags, removed area and hole count after holes up to a drawn area fraction."""
     target = rng.uniform(*REMOVED_RANGE) * surface.total_area
     removed = bytearray(len(surface.faces))
+    on_hole = bytearray(len(surface.verts))
     removed_area, holes = 0.0, 0
     cap = RHO_CAP * surface.diagonal
+
+    def free(f):
+        return not any(on_hole[v] for v in surface.faces[f])
+
     while removed_area < target:
-        seed = surface.sample_face(rng)
-        while removed[seed]:
-            seed = surface.sample_face(rng)
+        seed = surface.sample_face_where(rng, free)
+        if seed is None:
+            break
         rho = min(rng.uniform(*RHO_RANGE) * surface.feature_size(seed), cap)
         holes += 1
-        for f in surface.patch(seed, rho):
-            if removed[f]:
-                continue
-            removed[f] = 1
+        hole = []
+        for f in surface.patch(seed, rho, free):
+            hole.append(f)
             removed_area += surface.areas[f]
             if removed_area >= target:
                 break
+        for f in hole:
+            removed[f] = 1
+            for v in surface.faces[f]:
+                on_hole[v] = 1
     return removed, removed_area, holes
 
 
