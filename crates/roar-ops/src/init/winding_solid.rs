@@ -39,8 +39,8 @@
 //! concave side of a curved sheet, where `w` is just above ½, is capped on almost all its
 //! boundary), or, if wider, one hole of several: at most [`SHARED_CAP_SHARE`] of all its caps
 //! and [`SHARED_CAP_FRACTION`] of its boundary (a container has one opening, a surface punctured
-//! all over many holes, some merged into wide gaps). docs/method.md gives the figures that chose
-//! the defaults.
+//! all over many holes, nearby ones sharing one wide cap of voxels). docs/method.md gives the
+//! figures that chose the defaults.
 //!
 //! **Where the rule fails.** (a) A piece seen equally from both sides (module `orient`) keeps
 //! the orientation it came with; if it was stored inside out, `w` inside is lower there. (b)
