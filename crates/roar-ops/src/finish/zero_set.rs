@@ -105,7 +105,7 @@ pub fn fit_to_zero_set(mesh: &mut Mesh, sdf: &dyn Sdf, options: &ZeroSetOptions)
 /// each move shortened to `max_move_fraction` of the vertex's smallest height, then shortened
 /// or cancelled where faces would intersect, and undone where a face would turn over or
 /// become degenerate.
-fn limited_step(
+pub(crate) fn limited_step(
     positions: &[DVec3],
     wanted: &[DVec3],
     triangles: &[[u32; 3]],
