@@ -13,6 +13,7 @@ use roar_loss::{
 use roar_ops::blocks::collapse::FaceCollapseOptions;
 use roar_ops::blocks::split::DEFAULT_SPLIT_THRESHOLD;
 use roar_ops::finish::data_flips::DataFlipOptions;
+use roar_ops::finish::fair::FAIR_DISTANCE_OVER_EDGE;
 use roar_ops::finish::fins::FinOptions;
 use roar_ops::finish::slivers::SliverOptions;
 use roar_ops::finish::zero_set::ZeroSetOptions;
@@ -437,6 +438,14 @@ config_table! {
         /// `iterations > 0`. Not in the paper.
         fin_distance_over_edge: f64 = FinOptions::default().max_distance_over_edge,
             zero_or(0.01, 100.0);
+        /// For a soup, after the last polish: the vertices farther from the target surface T′
+        /// than this times their mean edge length (what no data holds: the caps over the soup's
+        /// holes) are moved to the thin-plate continuation of the surface around them, each
+        /// move limited so that no face folds or intersects (`roar_ops::finish::fair`; 0 =
+        /// off). The loop's Laplacian is a membrane, which leaves such caps flat and sunk. Runs
+        /// only when `iterations > 0` and the shape has no signed distance; off for range scans.
+        /// Not in the paper.
+        fair_distance_over_edge: f64 = FAIR_DISTANCE_OVER_EDGE, zero_or(0.01, 100.0);
         /// Last step: flip the edges of faces with aspect ratio `Q = R/(2r)` above this when
         /// both faces of the edge get better, the two are nearly coplanar and no intersection
         /// appears (`roar_ops::finish::slivers`; 0 = off); then degenerate faces that no flip
@@ -486,6 +495,7 @@ impl ReconstructConfig {
         let mut config = Self::default();
         config.init.enclosure_max_cap_fraction = 1.0;
         config.init.enclosure_max_cap_width = 1.0;
+        config.finish.fair_distance_over_edge = 0.0;
         config.keep_the_full_rig();
         config.loss.planar_max_samples = 50_000;
         config.loss.planar_t2s_max_points = 0;
@@ -944,6 +954,13 @@ mod tests {
         assert_eq!(c.finish.polish_iterations, 20);
         assert_eq!(c.finish.sliver_quality, 10.0);
         assert_eq!(c.finish.fin_distance_over_edge, 0.5);
+        assert_eq!(c.finish.fair_distance_over_edge, 0.3);
+        assert_eq!(
+            ReconstructConfig::scan_defaults()
+                .finish
+                .fair_distance_over_edge,
+            0.0
+        );
         assert_eq!(c.finish.untangle_margin, 1e-6);
         assert_eq!(
             (c.finish.zero_set_steps, c.loss.sdf_loss_epsilon),

@@ -103,6 +103,7 @@ impl Reconstruction {
             loss,
             &objective.projector,
             shape.signed_distance().as_deref(),
+            shape.target_surface(),
             &rig.normalization,
             &mut run,
         )?;

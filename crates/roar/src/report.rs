@@ -134,6 +134,11 @@ pub struct FinishReport {
     /// Vertices that step held back, wholly or in part (a long move, a face turned over, an
     /// intersection).
     pub zero_set_held: usize,
+    /// Vertices the fairing found unsupported (`fair_distance_over_edge`; 0 also when the
+    /// faired mesh was dropped because it would have intersected itself).
+    pub fair_free: usize,
+    /// Of those, the vertices moved the whole way to their faired position.
+    pub fair_faired: usize,
     /// Sliver flips in the output (`sliver_quality`; 0 also when they were undone because the
     /// written mesh would have intersected itself).
     pub sliver_flips: usize,

@@ -20,6 +20,7 @@
 use std::borrow::Cow;
 use std::sync::Arc;
 
+use glam::DVec3;
 use roar_mesh::Mesh;
 use roar_mesh::spatial::{Normalization, Projector, Sdf};
 use roar_render::{Camera, Image};
@@ -139,6 +140,12 @@ pub trait Shape {
     /// A projector onto the shape for the Face Split block's scores, if the shape has a better
     /// one than the default k-NN planar projection over [`Shape::point_cloud`].
     fn projector(&self) -> Option<&dyn Projector> {
+        None
+    }
+
+    /// The surface the target renders show (a soup's cleaned-up T′), in rig coordinates, if
+    /// the shape has one: the finish fairs what lies far from it.
+    fn target_surface(&self) -> Option<(&[DVec3], &[[u32; 3]])> {
         None
     }
 

@@ -83,6 +83,11 @@ impl Shape for SoupShape<'_> {
         &self.name
     }
 
+    fn target_surface(&self) -> Option<(&[DVec3], &[[u32; 3]])> {
+        let target = self.target.as_ref()?;
+        Some((&target.positions, &target.triangles))
+    }
+
     /// Builds T′ with the configured clean-up rig (`views_per_axis`, `render_resolution`,
     /// `twin_ratio`); its target renders are rendered again only if `cameras` is another rig.
     fn prepare(&mut self, cameras: &[Camera]) -> Result<(), ShapeError> {

@@ -10,7 +10,7 @@ use std::convert::Infallible;
 use glam::DVec3;
 use roar_loss::{KnnPlanarProjector, Loss};
 use roar_mesh::Mesh;
-use roar_mesh::spatial::{Normalization, Sdf, self_intersecting_faces};
+use roar_mesh::spatial::{Normalization, Sdf, TriangleBvh, self_intersecting_faces};
 use roar_ops::blocks::smoothing::SmoothingOptions;
 use roar_ops::decimate::{DecimateOptions, DecimateStats, decimate};
 use roar_ops::finish::best_state::{
@@ -19,6 +19,7 @@ use roar_ops::finish::best_state::{
 use roar_ops::finish::data_flips::{DataFlipOptions, flip_toward_target};
 use roar_ops::finish::degenerate::{DegenerateOptions, collapse_degenerate_faces};
 use roar_ops::finish::exact_budget::{ExactBudgetOptions, decimate_to_exact_budget};
+use roar_ops::finish::fair::{FairOptions, FairStats, fair_free_vertices, vertices_far_from};
 use roar_ops::finish::fill::fill_to_budget;
 use roar_ops::finish::fins::{FinOptions, collapse_fins};
 use roar_ops::finish::offset::offset_outward;
@@ -40,6 +41,7 @@ pub(crate) fn finish(
     mut loss: Box<dyn Loss>,
     projector: &KnnPlanarProjector,
     field: Option<&dyn Sdf>,
+    surface: Option<(&[DVec3], &[[u32; 3]])>,
     normalization: &Normalization,
     run: &mut Run,
 ) -> Result<Mesh, PipelineError> {
@@ -102,6 +104,14 @@ pub(crate) fn finish(
         }
     }
     drop(loss);
+    if let Some(surface) = surface
+        && config.optimize.iterations > 0
+        && config.finish.fair_distance_over_edge > 0.0
+        && field.is_none()
+    {
+        mesh = fair_unsupported_if_clean(mesh, surface, normalization, config, &mut run.stats);
+        run.clock.lap("fair");
+    }
     if let Some(field) = field
         && config.optimize.iterations > 0
         && (config.finish.zero_set_steps > 0 || config.finish.fin_distance_over_edge > 0.0)
@@ -249,6 +259,31 @@ fn flip_toward_cloud_if_clean(
         flip_toward_target(flipped, &target_normal, &options).accepted
     });
     stats.finish.data_flips += flips;
+    mesh
+}
+
+/// The mesh with the vertices farther from the target `surface` than `fair_distance_over_edge`
+/// times their mean edge length faired (`roar_ops::finish::fair`), kept only if the result is
+/// free of self-intersections in the input's coordinates, as for the smoothing.
+fn fair_unsupported_if_clean(
+    mut mesh: Mesh,
+    surface: (&[DVec3], &[[u32; 3]]),
+    normalization: &Normalization,
+    config: &ReconstructConfig,
+    stats: &mut RunStats,
+) -> Mesh {
+    let bvh = TriangleBvh::build(surface.0, surface.1);
+    let near = |p, reach| bvh.closest_point_within(p, reach).is_some();
+    let free = vertices_far_from(&mut mesh, near, config.finish.fair_distance_over_edge);
+    let mut faired = FairStats::default();
+    let (mesh, changed) = keep_if_clean(mesh, normalization, |moved| {
+        faired = fair_free_vertices(moved, &free, &FairOptions::default());
+        faired.free
+    });
+    if changed > 0 {
+        stats.finish.fair_free = faired.free;
+        stats.finish.fair_faired = faired.faired;
+    }
     mesh
 }
 
