@@ -241,6 +241,11 @@ mod tests {
         (mesh, free, sphere)
     }
 
+    /// `|L x|²`.
+    fn thin_plate_energy(laplacian: &Laplacian, x: &[DVec3]) -> f64 {
+        laplacian.apply(x).iter().map(|v| v.length_squared()).sum()
+    }
+
     fn mean_radius_error(mesh: &Mesh, free: &[bool]) -> f64 {
         let (positions, _) = mesh.to_triangles();
         let errors: Vec<f64> = positions
@@ -306,13 +311,7 @@ mod tests {
         let (start, triangles) = mesh.to_triangles();
         let laplacian = Laplacian::cotangent(&start, &triangles);
         let x = thin_plate(&laplacian, &start, &free, 500);
-        let energy = |x: &[DVec3]| {
-            laplacian
-                .apply(x)
-                .iter()
-                .map(|v| v.length_squared())
-                .sum::<f64>()
-        };
+        let energy = |x: &[DVec3]| thin_plate_energy(&laplacian, x);
         let e0 = energy(&x);
         for v in (0..x.len()).filter(|&v| free[v]).step_by(7) {
             for axis in [DVec3::X, DVec3::Y, DVec3::Z] {
@@ -340,13 +339,7 @@ mod tests {
         let (mesh, _, _) = sunken_cap(0.5);
         let (x, triangles) = mesh.to_triangles();
         let laplacian = Laplacian::cotangent(&x, &triangles);
-        let energy = |x: &[DVec3]| {
-            laplacian
-                .apply(x)
-                .iter()
-                .map(|v| v.length_squared())
-                .sum::<f64>()
-        };
+        let energy = |x: &[DVec3]| thin_plate_energy(&laplacian, x);
         let gradient = laplacian.apply_transposed(&laplacian.apply(&x));
         let h = 1e-6;
         for v in (0..x.len()).step_by(5) {
