@@ -18,6 +18,16 @@ pub fn is_degenerate(q: f64, limit: f64) -> bool {
     q.is_nan() || q >= limit
 }
 
+/// The mean length of the edges at `v` (`None` for an isolated vertex): the local scale the
+/// finish's far-vertex tests (fin collapses, fairing) compare distances with.
+pub fn mean_edge_length(mesh: &Mesh, v: VertexId) -> Option<f64> {
+    let p = mesh.position(v);
+    let (sum, count) = mesh.neighbors(v).fold((0.0, 0), |(s, n), w| {
+        (s + (mesh.position(w) - p).length(), n + 1)
+    });
+    (count > 0).then(|| sum / count as f64)
+}
+
 /// Positions of `[a, b, c, d]` for edge (a, b) with faces (a, b, c) and (b, a, d): the quad that
 /// flipping the edge re-triangulates into (a, d, c), (b, c, d).
 pub fn flip_quad(mesh: &Mesh, e: EdgeId) -> [DVec3; 4] {

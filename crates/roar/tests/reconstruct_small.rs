@@ -271,3 +271,39 @@ fn keep_topology_fails_with_the_named_error_instead() {
         "{message}"
     );
 }
+
+#[test]
+fn a_hole_in_a_soup_is_filled_by_the_fairing_and_the_output_keeps_its_promises() {
+    // A torus soup with the faces around a point of its outer equator removed: the cap the loop
+    // spans across that hole lies far from every input face, so the finish fairs it.
+    let (positions, triangles) = torus_soup();
+    let centre = glam::DVec3::new(1.4, 0.0, 0.0);
+    let kept: Vec<[u32; 3]> = triangles
+        .iter()
+        .copied()
+        .filter(|t| {
+            let c = t
+                .iter()
+                .map(|&v| positions[v as usize])
+                .sum::<glam::DVec3>()
+                / 3.0;
+            c.distance(centre) > 0.3
+        })
+        .collect();
+    assert!(kept.len() < triangles.len());
+    let out = Reconstruction::new(toy_config(300))
+        .run_soup(&positions, &kept, &mut |_| {})
+        .unwrap();
+    let finish = &out.stats.finish;
+    assert!(finish.fair_free > 0, "no vertex was far from the soup");
+    assert!(
+        finish.fair_faired > 0,
+        "{} free, none faired",
+        finish.fair_free
+    );
+    assert_eq!(out.triangles.len(), 300);
+    let mesh = Mesh::from_triangles(out.positions.clone(), &out.triangles).unwrap();
+    mesh.validate().unwrap();
+    assert_eq!(mesh.genus(), 1);
+    assert!(!self_intersecting_faces(&out.positions, &out.triangles).contains(&true));
+}

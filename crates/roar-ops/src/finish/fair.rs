@@ -11,6 +11,7 @@ use glam::DVec3;
 use roar_mesh::Mesh;
 
 use crate::finish::zero_set::limited_step;
+use crate::geometry::mean_edge_length;
 
 /// The default distance, over a vertex's mean edge length, beyond which [`vertices_far_from`]
 /// marks it: on the tuning punctured inputs 0.3 leaves the outputs from the closed originals
@@ -26,24 +27,10 @@ pub fn vertices_far_from(
     distance_over_edge: f64,
 ) -> Vec<bool> {
     mesh.compact();
-    let (positions, triangles) = mesh.to_triangles();
-    let mut edge_sums = vec![(0.0, 0usize); positions.len()];
-    for t in &triangles {
-        for k in 0..3 {
-            let (a, b) = (t[k] as usize, t[(k + 1) % 3] as usize);
-            let length = positions[a].distance(positions[b]);
-            for v in [a, b] {
-                edge_sums[v].0 += length;
-                edge_sums[v].1 += 1;
-            }
-        }
-    }
-    positions
-        .iter()
-        .zip(&edge_sums)
-        .map(|(&p, &(sum, n))| {
-            let reach = distance_over_edge * sum / n.max(1) as f64;
-            !near(p, reach)
+    mesh.vertices()
+        .map(|v| {
+            mean_edge_length(mesh, v)
+                .is_some_and(|edge| !near(mesh.position(v), distance_over_edge * edge))
         })
         .collect()
 }
@@ -76,22 +63,22 @@ impl Default for FairOptions {
 pub struct FairStats {
     /// Vertices marked free.
     pub free: usize,
-    /// Free vertices that reached their faired position.
+    /// Free vertices that reached their faired position (the others were moved part of the way
+    /// or not at all: a move that would fold a face or make faces intersect).
     pub faired: usize,
-    /// Free vertices moved part of the way or not at all (a move that would fold a face or make
-    /// faces intersect).
-    pub held: usize,
 }
 
-/// Moves the vertices with `free[v]` (indexed as `mesh.to_triangles` numbers them after
-/// `mesh.compact()`) to the positions minimizing the thin-plate energy with the others fixed,
-/// through `options.steps` limited steps (as `fit_to_zero_set` moves). The topology stays; the
-/// mesh stays free of self-intersections when it was.
+/// Moves the vertices with `free[v]` (one flag per vertex, indexed as `mesh.to_triangles`
+/// numbers them after `mesh.compact()`, as [`vertices_far_from`] gives them) to the positions
+/// minimizing the thin-plate energy with the others fixed, through `options.steps` limited steps
+/// (as `fit_to_zero_set` moves). The topology stays; the mesh stays free of self-intersections
+/// when it was. Panics when `free` has another length than the mesh has vertices.
 pub fn fair_free_vertices(mesh: &mut Mesh, free: &[bool], options: &FairOptions) -> FairStats {
     mesh.compact();
     let (start, triangles) = mesh.to_triangles();
+    assert_eq!(free.len(), start.len(), "one flag per vertex");
     let count = free.iter().filter(|&&f| f).count();
-    if count == 0 || free.len() != start.len() {
+    if count == 0 {
         return FairStats::default();
     }
     let laplacian = Laplacian::cotangent(&start, &triangles);
@@ -107,7 +94,6 @@ pub fn fair_free_vertices(mesh: &mut Mesh, free: &[bool], options: &FairOptions)
     FairStats {
         free: count,
         faired,
-        held: count - faired,
     }
 }
 

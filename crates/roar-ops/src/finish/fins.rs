@@ -30,7 +30,7 @@
 use crate::blocks::block::BlockStats;
 use crate::blocks::guard::collapse_if_clean;
 use crate::finish::degenerate::reshaped_faces_ok;
-use crate::geometry::DEGENERATE_QUALITY;
+use crate::geometry::{DEGENERATE_QUALITY, mean_edge_length};
 use glam::DVec3;
 use roar_mesh::spatial::{Sdf, first_order_distances};
 use roar_mesh::{HalfedgeId, Mesh, VertexId};
@@ -121,12 +121,8 @@ fn far_vertices(mesh: &Mesh, distances: &[f64], factor: f64) -> Vec<VertexId> {
     let mut far: Vec<(f64, VertexId)> = mesh
         .vertices()
         .filter_map(|v| {
-            let p = mesh.position(v);
-            let (sum, count) = mesh.neighbors(v).fold((0.0, 0), |(s, n), w| {
-                (s + (mesh.position(w) - p).length(), n + 1)
-            });
             let d = distances[v.index()];
-            (count > 0 && d > factor * sum / count as f64).then_some((d, v))
+            (d > factor * mean_edge_length(mesh, v)?).then_some((d, v))
         })
         .collect();
     far.sort_by(|a, b| b.0.total_cmp(&a.0));

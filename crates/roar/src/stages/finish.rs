@@ -1,9 +1,9 @@
 //! The finish stage: the lowest-loss loop state the untangle block clears, filled to N; the
 //! final QEMs (to 2N and polish first when the mesh is larger), each followed by smoothing,
 //! data flips and the polish; for a soup the fairing of what lies far from T′; for an SDF input
-//! the fin collapses and the fit to the field's zero set; then sliver flips. Every step after the QEMs goes through [`keep_if_clean`]: it is
-//! kept only if the mesh stays free of self-intersections in the input's coordinates, where it
-//! will be written.
+//! the fin collapses and the fit to the field's zero set; then sliver flips. Every step after
+//! the QEMs goes through [`keep_if_clean`]: it is kept only if the mesh stays free of
+//! self-intersections in the input's coordinates, where it will be written.
 
 use std::convert::Infallible;
 
